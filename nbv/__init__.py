@@ -1,0 +1,1 @@
+"""Next-best-view planning: features, Bag of Views, refinement, RL, reconstruction, metrics."""

@@ -1,0 +1,108 @@
+"""Scan plans: the View Planning Toolbox's hemispherical scan and a circular scan (paper Sec. V-B).
+
+Spacing follows photogrammetric end and side overlap under the paper's flat-plane,
+small-angle approximations: at distance R an image covers R * W / fx by
+R * H / fx metres. Moving along a ring at elevation theta (ring radius
+R cos theta) by (1 - end_overlap) of the image width gives the azimuth step
+(1 - end_overlap) * (W / fx) / cos(theta); rings are (1 - side_overlap) of the
+image height apart, an elevation step of (1 - side_overlap) * H / fx. The
+defaults (35 mm lens, 86 % end and 80 % side overlap, elevations 5 to 90
+degrees) give 288 views, the paper's count.
+
+Order: rings from the lowest up, each counter-clockwise from azimuth 0; the
+single view at the pole (if the rings reach it) comes last.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from render.camera import UAVCamera
+from render.viewpoint import TWO_PI, Viewpoint
+
+
+@dataclass(frozen=True)
+class HemispherePlan:
+    """A full-coverage hemisphere scan at constant radius."""
+
+    radius: float = 2.0
+    """Distance of every camera from the scene centre, metres."""
+    end_overlap: float = 0.86
+    """Overlap of consecutive images along a ring, in [0, 1)."""
+    side_overlap: float = 0.8
+    """Overlap of images on neighbouring rings, in [0, 1)."""
+    min_elevation_deg: float = 5.0
+    """Elevation of the lowest ring, degrees."""
+    max_elevation_deg: float = 90.0
+    """Elevation of the highest ring (90: a single view at the pole), degrees."""
+
+
+@dataclass(frozen=True)
+class CirclePlan:
+    """One ring of views at a fixed elevation."""
+
+    radius: float = 2.0
+    """Distance of every camera from the scene centre, metres."""
+    elevation_deg: float = 30.0
+    """Elevation of the ring, degrees."""
+    views: int | None = 24
+    """Number of evenly spaced views; None to derive it from `end_overlap`."""
+    end_overlap: float = 0.85
+    """Overlap of consecutive images, used when `views` is None."""
+
+
+def _check_overlap(name: str, value: float) -> None:
+    if not 0.0 <= value < 1.0:
+        raise ValueError(f"{name} must lie in [0, 1), got {value}")
+
+
+def _check_radius(radius: float) -> None:
+    if not (math.isfinite(radius) and radius > 0):
+        raise ValueError(f"scan radius must be positive and finite, got {radius}")
+
+
+def azimuth_step(camera: UAVCamera, end_overlap: float, elevation: float) -> float:
+    """Azimuth step (radians) keeping `end_overlap` between neighbours on a ring at `elevation`."""
+    _check_overlap("end_overlap", end_overlap)
+    return (1.0 - end_overlap) * (camera.width / camera.fx) / max(math.cos(elevation), 1e-9)
+
+
+def ring(radius: float, elevation: float, count: int) -> list[Viewpoint]:
+    """`count` evenly spaced viewpoints on a ring, counter-clockwise from azimuth 0."""
+    return [Viewpoint(radius, TWO_PI * k / count, elevation) for k in range(count)]
+
+
+def hemisphere_scan(camera: UAVCamera, plan: HemispherePlan = HemispherePlan()) -> list[Viewpoint]:
+    """Viewpoints of a hemispherical scan with the plan's end and side overlap."""
+    _check_radius(plan.radius)
+    _check_overlap("side_overlap", plan.side_overlap)
+    lo, hi = math.radians(plan.min_elevation_deg), math.radians(plan.max_elevation_deg)
+    if not -math.pi / 2 < lo <= hi <= math.pi / 2:
+        raise ValueError(f"need -90 < min_elevation_deg <= max_elevation_deg <= 90, got "
+                         f"{plan.min_elevation_deg}, {plan.max_elevation_deg}")
+    step = (1.0 - plan.side_overlap) * camera.height / camera.fx
+    views: list[Viewpoint] = []
+    elevation = lo
+    while elevation <= hi + 1e-9:
+        if math.pi / 2 - elevation < 1e-6:
+            views.append(Viewpoint(plan.radius, 0.0, math.pi / 2))
+            break
+        count = math.ceil(TWO_PI / azimuth_step(camera, plan.end_overlap, elevation) - 1e-9)
+        views.extend(ring(plan.radius, elevation, max(count, 1)))
+        elevation = min(elevation + step, hi) if elevation < hi - 1e-9 else hi + 1.0
+    return views
+
+
+def circle_scan(camera: UAVCamera, plan: CirclePlan = CirclePlan()) -> list[Viewpoint]:
+    """Viewpoints of a circular scan, by view count or by end overlap."""
+    _check_radius(plan.radius)
+    elevation = math.radians(plan.elevation_deg)
+    if not -math.pi / 2 < elevation < math.pi / 2:
+        raise ValueError(f"circle elevation_deg must lie in (-90, 90), got {plan.elevation_deg}")
+    if plan.views is not None:
+        if plan.views < 1:
+            raise ValueError(f"circle views must be >= 1, got {plan.views}")
+        return ring(plan.radius, elevation, plan.views)
+    count = math.ceil(TWO_PI / azimuth_step(camera, plan.end_overlap, elevation) - 1e-9)
+    return ring(plan.radius, elevation, count)

@@ -167,10 +167,11 @@ class MitsubaRenderer:
                        has_vertex_normals=False, has_vertex_texcoords=part.uv is not None)
         params = mi.traverse(mesh)
         # Buffer types differ per variant (dynamic arrays in scalar, JIT arrays in LLVM/CUDA).
-        params["vertex_positions"] = type(params["vertex_positions"])(part.vertices.astype(np.float32).ravel())
-        params["faces"] = type(params["faces"])(part.faces.astype(np.uint32).ravel())
-        if part.uv is not None:
-            params["vertex_texcoords"] = type(params["vertex_texcoords"])(part.uv.astype(np.float32).ravel())
+        for key, array in (("vertex_positions", part.vertices.astype(np.float32)),
+                           ("faces", part.faces.astype(np.uint32)),
+                           ("vertex_texcoords", None if part.uv is None else part.uv.astype(np.float32))):
+            if array is not None:
+                params[key] = type(params[key])(array.ravel())
         params.update()
         return mesh
 

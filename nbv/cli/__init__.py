@@ -13,6 +13,7 @@ import sys
 COMMANDS = (
     "scene",
     "scan",
+    "demo",
     "bench",
 )
 """Sub-command modules under `nbv.cli`, in `--help` order."""

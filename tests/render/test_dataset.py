@@ -62,7 +62,8 @@ def backproject_from_files(root):
     fx, fy, cx, cy = doc["fl_x"], doc["fl_y"], doc["cx"], doc["cy"]
     points = []
     for frame in doc["frames"]:
-        depth = cv2.imread(str(root / frame["depth_file_path"]), cv2.IMREAD_UNCHANGED) * doc["depth_unit_scale_factor"]
+        raw = cv2.imread(str(root / frame["depth_file_path"]), cv2.IMREAD_UNCHANGED)
+        depth = raw * doc["depth_unit_scale_factor"]
         v, u = np.nonzero(depth > 0)
         z = depth[v, u]
         # nerfstudio puts pixel centres at +0.5, and its camera is OpenGL (y up, z backward).
@@ -136,8 +137,10 @@ def test_unwritable_output_folder_is_named(tmp_path):
     (lambda d: (d / "transforms.json").write_text("{not json"), "corrupt JSON"),
     (lambda d: (d / "transforms.json").unlink(), "not found"),
     (lambda d: _edit(d, lambda doc: doc.pop("w")), "field w is missing"),
-    (lambda d: _edit(d, lambda doc: doc["frames"][1].pop("transform_matrix")), r"frames\[1\].transform_matrix"),
-    (lambda d: _edit(d, lambda doc: doc["frames"][0]["transform_matrix"][0].__setitem__(3, float("nan"))), "NaN"),
+    (lambda d: _edit(d, lambda doc: doc["frames"][1].pop("transform_matrix")),
+     r"frames\[1\].transform_matrix"),
+    (lambda d: _edit(d, lambda doc: doc["frames"][0]["transform_matrix"][0].__setitem__(3, float("nan"))),
+     "NaN"),
     (lambda d: (d / "images" / "0002.png").unlink(), r"frames\[2\].file_path names a missing file"),
 ])
 def test_corrupt_datasets_name_the_file_and_field(tmp_path, corrupt, message):

@@ -77,11 +77,13 @@ def add_config_arguments(parser: argparse.ArgumentParser, cls: type) -> None:
         if default is not None:
             kwargs["help"] += f" (default: {_show(default)})"
         flag = "--" + f.name.replace("_", "-")
+        required = default is None and not optional
         if f.metadata.get("repeat"):
+            # Given values replace the default rather than extend it.
             kwargs["action"] = "append"
             kwargs.pop("nargs", None)
-        parser.add_argument(flag, dest=f.name, default=default,
-                            required=default is None and not optional, **kwargs)
+            default = None
+        parser.add_argument(flag, dest=f.name, default=default, required=required, **kwargs)
 
 
 def _show(value: Any) -> str:
@@ -93,6 +95,8 @@ def config_from_args(cls: type[T], namespace: argparse.Namespace) -> T:
     values = {}
     for f in dataclasses.fields(cls):
         value = getattr(namespace, f.name)
+        if value is None and f.metadata.get("repeat"):
+            continue  # not given: the field's default
         values[f.name] = tuple(value) if isinstance(value, list) else value
     return cls(**values)
 

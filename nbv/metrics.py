@@ -147,7 +147,8 @@ def metrics_from_distances(to_reference: np.ndarray, to_prediction: np.ndarray,
         threshold_cm=float(threshold_cm), n_points=int(min(len(to_reference), len(to_prediction))))
 
 
-def compare_points(prediction: np.ndarray, reference: np.ndarray, threshold_cm: float = 1.0) -> SurfaceMetrics:
+def compare_points(prediction: np.ndarray, reference: np.ndarray,
+                   threshold_cm: float = 1.0) -> SurfaceMetrics:
     """Metrics between two point sets (metres); see the module docstring for the definitions."""
     prediction = as_points(prediction, "reconstruction")
     reference = as_points(reference, "reference")

@@ -13,6 +13,8 @@ import sys
 COMMANDS = (
     "scene",
     "scan",
+    "reconstruct",
+    "evaluate",
     "demo",
     "bench",
 )

@@ -1,0 +1,311 @@
+"""The online next-best-view problem as a TorchRL environment (paper Sec. IV, DESIGN section 5).
+
+State: the last `history` (tau = 5) grayscale frames, downsampled to
+`obs_size` x `obs_size` (uint8, key `pixels`), and the last `history`
+viewpoints (R, azimuth, elevation), each normalised to [-1, 1] over its allowed
+range (key `viewpoints`). At reset both histories hold copies of the first view.
+
+Action: three values in [-1, 1]. In the paper's `absolute` mode they are the
+next viewpoint itself, rescaled to the allowed ranges of R, azimuth and
+elevation ("rescaled to conform to the specified ranges", Sec. IV); in the
+`relative` mode they are a step from the current viewpoint, at most
+`relative_step` of each range, clipped to the ranges.
+
+Reward: the Bag of Views reward of the new view (vocabulary change - 1,
+DESIGN section 3). The BoV is emptied at each reset and learns the episode's
+first view without reward.
+
+Termination: one pass around the target, i.e. the net azimuth travelled
+(each step's change wrapped to (-pi, pi]) reaches 2 pi in either direction.
+Truncation: `max_steps` steps.
+
+Rendering: one renderer per scene, created lazily on the first reset, in the
+process that steps the env, so `ParallelEnv`'s spawned workers each choose
+their own Mitsuba variant. The constructor takes only picklable settings.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import cv2
+import numpy as np
+import torch
+from tensordict import TensorDict, TensorDictBase
+from torchrl.data import Bounded, Categorical, Composite, Unbounded
+from torchrl.envs import EnvBase
+
+from nbv.bov import BagOfViews
+from nbv.cli.config_args import repeated
+from nbv.features import FeatureConfig, extract_features
+from render.camera import UAVCamera
+from render.renderer import MitsubaRenderer, RenderSettings
+from render.viewpoint import TWO_PI, Viewpoint, viewpoint_to_c2w
+from scenes import load_scene
+
+
+@dataclass(frozen=True)
+class EnvConfig:
+    """The NBV environment: scenes, camera, allowed viewpoints, episode, Bag of Views."""
+
+    scene: tuple[str, ...] = repeated()
+    """Scene(s) to fly around (give --scene several times); episodes cycle through them."""
+    width: int = 320
+    """Render width, pixels (the resolution the features see)."""
+    height: int = 240
+    """Render height, pixels."""
+    focal_mm: float = 35.0
+    """Focal length, mm, on the 36 x 24 mm sensor."""
+    spp: int = 16
+    """RGB samples per pixel of the renders."""
+    obs_size: int = 64
+    """Side of the square grayscale frames the policy sees, pixels."""
+    history: int = 5
+    """Frames and viewpoints in the state (the paper's tau)."""
+    radius_min: float = 1.5
+    """Smallest allowed camera distance from the scene centre, metres."""
+    radius_max: float = 2.5
+    """Largest allowed camera distance from the scene centre, metres."""
+    elevation_min_deg: float = 5.0
+    """Lowest allowed elevation, degrees."""
+    elevation_max_deg: float = 80.0
+    """Highest allowed elevation, degrees."""
+    max_steps: int = 30
+    """Step cap of an episode (truncation)."""
+    action_mode: Literal["absolute", "relative"] = "absolute"
+    """Action meaning: the next viewpoint (paper) or a step from the current one."""
+    relative_step: float = 0.25
+    """Relative mode: the largest step per action, as a fraction of each range (azimuth: of 2 pi)."""
+    bov_ranges: int = 8
+    """Azimuth ranges (vocabularies) of the Bag of Views."""
+    bov_words: int = 20
+    """Visual words per vocabulary."""
+    bov_memory: int = 2048
+    """Descriptors a vocabulary keeps to re-cluster from."""
+    feature_backend: Literal["kornia", "opencv"] = "kornia"
+    """SIFT implementation."""
+    max_features: int = 500
+    """Most SIFT keypoints per view."""
+    variant: Literal["scalar_rgb", "llvm_ad_rgb", "cuda_ad_rgb"] | None = None
+    """Mitsuba variant; default: $NBV_VARIANT, else the fastest available (chosen per worker)."""
+
+    def __post_init__(self) -> None:
+        if not self.scene:
+            raise ValueError("the environment needs at least one scene")
+        if not 0 < self.radius_min <= self.radius_max:
+            raise ValueError(f"need 0 < radius_min <= radius_max, got {self.radius_min}, {self.radius_max}")
+        if not -90 < self.elevation_min_deg <= self.elevation_max_deg < 90:
+            raise ValueError("need -90 < elevation_min_deg <= elevation_max_deg < 90, got "
+                             f"{self.elevation_min_deg}, {self.elevation_max_deg}")
+        for name in ("width", "height", "spp", "obs_size", "history", "max_steps", "bov_ranges", "bov_words"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
+        if not 0 < self.relative_step <= 1:
+            raise ValueError(f"relative_step must lie in (0, 1], got {self.relative_step}")
+
+    @property
+    def low(self) -> np.ndarray:
+        """Lower bounds of (R, azimuth, elevation), radians."""
+        return np.array([self.radius_min, 0.0, math.radians(self.elevation_min_deg)])
+
+    @property
+    def high(self) -> np.ndarray:
+        """Upper bounds of (R, azimuth, elevation), radians."""
+        return np.array([self.radius_max, TWO_PI, math.radians(self.elevation_max_deg)])
+
+    @property
+    def camera(self) -> UAVCamera:
+        """The render camera."""
+        return UAVCamera(self.width, self.height, self.focal_mm)
+
+
+def check_action(action: Any) -> np.ndarray:
+    """The action as float64 (3,), or a ValueError if it is NaN, infinite or outside [-1, 1]."""
+    a = np.asarray(action.detach().cpu() if isinstance(action, torch.Tensor) else action, dtype=np.float64)
+    if a.shape != (3,):
+        raise ValueError(f"an NBV action has 3 values (R, azimuth, elevation), got shape {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"NBV action contains NaN or infinite values: {a.tolist()}")
+    if np.any(np.abs(a) > 1.0 + 1e-6):
+        raise ValueError(f"NBV action must lie in [-1, 1], got {a.tolist()}")
+    return np.clip(a, -1.0, 1.0)
+
+
+def normalise_viewpoint(view: Viewpoint, config: EnvConfig) -> np.ndarray:
+    """(R, azimuth, elevation) mapped to [-1, 1] over the allowed ranges (the inverse of `absolute`)."""
+    return 2.0 * (view.as_array() - config.low) / np.maximum(config.high - config.low, 1e-12) - 1.0
+
+
+def action_to_viewpoint(action: Any, current: Viewpoint, config: EnvConfig) -> Viewpoint:
+    """The next viewpoint an action asks for, under the config's action mode."""
+    a = check_action(action)
+    low, high = config.low, config.high
+    if config.action_mode == "absolute":
+        r, az, el = low + (a + 1.0) / 2.0 * (high - low)
+    else:
+        r, az, el = current.as_array() + a * config.relative_step * (high - low)
+        r, el = np.clip(r, low[0], high[0]), np.clip(el, low[2], high[2])
+    return Viewpoint(float(r), float(az) % TWO_PI, float(el))
+
+
+def wrap_angle(angle: float) -> float:
+    """An angle difference wrapped to (-pi, pi]."""
+    wrapped = math.remainder(angle, TWO_PI)
+    return math.pi if wrapped == -math.pi else wrapped
+
+
+def gray_frame(rgb: np.ndarray, size: int) -> np.ndarray:
+    """An sRGB uint8 image as a `size` x `size` uint8 grayscale frame (area-averaged)."""
+    gray = cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY)
+    return cv2.resize(gray, (size, size), interpolation=cv2.INTER_AREA)
+
+
+class NBVEnv(EnvBase):
+    """Next-best-view planning around one target at a time, rewarded by the Bag of Views.
+
+    Args:
+        config: scenes, camera, allowed ranges, episode and Bag of Views settings.
+        worker: index of this env among parallel workers; it offsets the scene order.
+        seed: seed of the start viewpoints, the render noise and the BoV clustering.
+
+    Example:
+        >>> env = NBVEnv(EnvConfig(scene=("test_building",), width=64, height=48, obs_size=32))
+        >>> td = env.rollout(3)
+    """
+
+    def __init__(self, config: EnvConfig, worker: int = 0, seed: int = 0) -> None:
+        super().__init__(device="cpu", batch_size=torch.Size([]))
+        self.config = config
+        self.worker = worker
+        tau, side = config.history, config.obs_size
+        self.observation_spec = Composite(
+            pixels=Bounded(0, 255, shape=(tau, side, side), dtype=torch.uint8),
+            viewpoints=Bounded(-1.0, 1.0, shape=(tau, 3), dtype=torch.float32),
+        )
+        self.action_spec = Bounded(-1.0, 1.0, shape=(3,), dtype=torch.float32)
+        self.reward_spec = Unbounded(shape=(1,), dtype=torch.float32)
+        self.done_spec = Composite(
+            done=Categorical(2, shape=(1,), dtype=torch.bool),
+            terminated=Categorical(2, shape=(1,), dtype=torch.bool),
+            truncated=Categorical(2, shape=(1,), dtype=torch.bool),
+        )
+        self._renderers: dict[str, MitsubaRenderer] = {}
+        self._features = FeatureConfig(backend=config.feature_backend, max_features=config.max_features)
+        self._bov: BagOfViews | None = None
+        self._resume_pending = False
+        self._set_seed(seed)
+
+    # -- TorchRL hooks -------------------------------------------------------------------------
+
+    def _set_seed(self, seed: int | None) -> None:
+        self._seed = int(seed or 0)
+        self._rng = np.random.default_rng(self._seed)
+        self._episode = 0
+        self._views_rendered = 0
+        self._bov = None
+
+    def _reset(self, tensordict: TensorDictBase | None = None, **kwargs) -> TensorDictBase:
+        if self._resume_pending:
+            # A restored snapshot continues its episode: the collector's first reset resumes it.
+            self._resume_pending = False
+            return self._observation()
+        self._scene = self.config.scene[(self.worker + self._episode) % len(self.config.scene)]
+        self._episode += 1
+        low, high = self.config.low, self.config.high
+        radius, azimuth, elevation = low + self._rng.random(3) * (high - low)
+        self._view = Viewpoint(float(radius), float(azimuth), float(elevation))
+        self.bov.reset()
+        frame, descriptors = self.capture(self._view)
+        self.bov.update(descriptors, self._view.azimuth)
+        location = normalise_viewpoint(self._view, self.config)
+        self._frames = np.repeat(frame[None], self.config.history, axis=0)
+        self._locations = np.repeat(location[None], self.config.history, axis=0)
+        self._progress = 0.0
+        self._steps = 0
+        return self._observation()
+
+    def _step(self, tensordict: TensorDictBase) -> TensorDictBase:
+        view = action_to_viewpoint(tensordict["action"], self._view, self.config)
+        frame, descriptors = self.capture(view)
+        reward = self.bov.reward(descriptors, view.azimuth)
+        self._progress += wrap_angle(view.azimuth - self._view.azimuth)
+        self._view = view
+        self._steps += 1
+        self._frames = np.concatenate([self._frames[1:], frame[None]])
+        self._locations = np.concatenate([self._locations[1:], normalise_viewpoint(view, self.config)[None]])
+        terminated = abs(self._progress) >= TWO_PI - 1e-9
+        truncated = not terminated and self._steps >= self.config.max_steps
+        out = self._observation(terminated, truncated)
+        out.set("reward", torch.tensor([reward], dtype=torch.float32))
+        return out
+
+    # -- state ---------------------------------------------------------------------------------
+
+    @property
+    def bov(self) -> BagOfViews:
+        """The episode's Bag of Views (created on first use)."""
+        if self._bov is None:
+            self._bov = BagOfViews(self.config.bov_ranges, self.config.bov_words,
+                                   memory_cap=self.config.bov_memory, seed=self._seed)
+        return self._bov
+
+    @property
+    def viewpoint(self) -> Viewpoint:
+        """The current camera viewpoint."""
+        return self._view
+
+    def snapshot(self) -> dict[str, Any]:
+        """The env's full runtime state (episode, histories, RNG, BoV), loadable with weights_only."""
+        return {
+            "seed": self._seed, "episode": self._episode, "views_rendered": self._views_rendered,
+            "rng": self._rng.bit_generator.state, "scene": self._scene,
+            "view": self._view.as_array().tolist(), "frames": torch.from_numpy(self._frames.copy()),
+            "locations": torch.from_numpy(self._locations.copy()),
+            "progress": self._progress, "steps": self._steps, "bov": self.bov.state_dict(),
+        }
+
+    def restore(self, state: dict[str, Any]) -> None:
+        """Load a `snapshot`; the next reset continues the restored episode instead of starting one."""
+        self._set_seed(state["seed"])
+        self._episode, self._views_rendered = int(state["episode"]), int(state["views_rendered"])
+        self._rng.bit_generator.state = state["rng"]
+        self._scene = str(state["scene"])
+        self._view = Viewpoint(*map(float, state["view"]))
+        self._frames, self._locations = state["frames"].numpy().copy(), state["locations"].numpy().copy()
+        self._progress, self._steps = float(state["progress"]), int(state["steps"])
+        self.bov.load_state_dict(state["bov"])
+        self._resume_pending = True
+
+    # -- rendering -----------------------------------------------------------------------------
+
+    def render_view(self, view: Viewpoint) -> np.ndarray:
+        """The sRGB image at `view` of the current scene (advances the per-view render seed)."""
+        renderer = self._renderer(self._scene)
+        seed = (self._seed * 1_000_003 + self._views_rendered) % 2**31
+        self._views_rendered += 1
+        return renderer.render_rgb(viewpoint_to_c2w(view, renderer.center), seed=seed)
+
+    def capture(self, view: Viewpoint) -> tuple[np.ndarray, torch.Tensor]:
+        """Render `view` of the current scene: its policy frame (S x S uint8), SIFT descriptors (M, 128)."""
+        rgb = self.render_view(view)
+        descriptors = torch.as_tensor(extract_features([rgb], self._features)[0].descriptors)
+        return gray_frame(rgb, self.config.obs_size), descriptors
+
+    def _renderer(self, scene: str) -> MitsubaRenderer:
+        if scene not in self._renderers:
+            settings = RenderSettings(spp=self.config.spp, seed=self._seed)
+            self._renderers[scene] = MitsubaRenderer(load_scene(scene), self.config.camera, settings,
+                                                     self.config.variant)
+        return self._renderers[scene]
+
+    def _observation(self, terminated: bool = False, truncated: bool = False) -> TensorDict:
+        return TensorDict({
+            "pixels": torch.from_numpy(self._frames.copy()),
+            "viewpoints": torch.from_numpy(self._locations.astype(np.float32)),
+            "done": torch.tensor([terminated or truncated]),
+            "terminated": torch.tensor([terminated]),
+            "truncated": torch.tensor([truncated]),
+        }, batch_size=self.batch_size)
+

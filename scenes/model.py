@@ -43,7 +43,8 @@ class Part:
     material: Material
     """Surface appearance."""
     uv: np.ndarray | None = None
-    """(V, 2) float texture coordinates, or None."""
+    """(V, 2) float texture coordinates, or None. As Mitsuba samples bitmaps, v grows down the
+    image (v = 0 is its top row); OBJ-style coordinates (v up) are flipped when a mesh is loaded."""
     target: bool = True
     """False for context geometry (the ground) that metrics must ignore."""
 

@@ -54,6 +54,8 @@ class ReconstructionConfig:
     """Depth samples farther than this (metres) are ignored."""
     min_observations: int = 1
     """Voxels fused from fewer views than this are left out of the mesh and the point cloud."""
+    color: bool = True
+    """Fuse colours into the mesh and points (about a third of the fusion time); off: geometry only."""
     crop_ground: bool = True
     """Remove the ground plane z = 0 (depth points and reconstructed surface below the crop height)."""
     ground_crop_voxels: float = 1.0
@@ -144,10 +146,10 @@ class TSDFFusion:
         self._rays = np.stack([(u - k[0, 2]) / k[0, 0], (v - k[1, 2]) / k[1, 1],
                                np.ones(u.shape)], axis=-1)
         self._trunc_voxels = config.truncation_m / config.voxel_size_m
+        attrs = (("tsdf", 1), ("weight", 1)) + ((("color", 3),) if config.color else ())
         self.grid = o3d.t.geometry.VoxelBlockGrid(
-            ("tsdf", "weight", "color"), (o3c.float32, o3c.float32, o3c.float32),
-            ((1,), (1,), (3,)), config.voxel_size_m, config.block_resolution,
-            config.initial_blocks, self.device)
+            tuple(a for a, _ in attrs), (o3c.float32,) * len(attrs), tuple((c,) for _, c in attrs),
+            config.voxel_size_m, config.block_resolution, config.initial_blocks, self.device)
         self.n_views = 0
 
     def integrate(self, rgb: np.ndarray, depth: np.ndarray, c2w: np.ndarray) -> None:
@@ -173,11 +175,14 @@ class TSDFFusion:
             return  # nothing to fuse; Open3D would abort on a view that touches no block
         extrinsic = o3c.Tensor(np.linalg.inv(pose), o3c.float64)
         depth_img = o3d.t.geometry.Image(o3c.Tensor(np.ascontiguousarray(depth)).to(self.device))
-        color_img = o3d.t.geometry.Image(
-            o3c.Tensor(np.ascontiguousarray(rgb, dtype=np.float32) / np.float32(255)).to(self.device))
         args = (1.0, self.config.depth_max_m, self._trunc_voxels)
         blocks = self.grid.compute_unique_block_coordinates(depth_img, self._intrinsic, extrinsic, *args)
-        self.grid.integrate(blocks, depth_img, color_img, self._intrinsic, extrinsic, *args)
+        if self.config.color:
+            color_img = o3d.t.geometry.Image(
+                o3c.Tensor(np.ascontiguousarray(rgb, dtype=np.float32) / np.float32(255)).to(self.device))
+            self.grid.integrate(blocks, depth_img, color_img, self._intrinsic, extrinsic, *args)
+        else:
+            self.grid.integrate(blocks, depth_img, self._intrinsic, extrinsic, *args)
 
     def _weight_threshold(self) -> float:
         # Open3D keeps voxels whose weight is strictly above the threshold; each view adds 1.
@@ -192,7 +197,7 @@ class TSDFFusion:
         if len(vertices) == 0:
             return trimesh.Trimesh(np.zeros((0, 3)), np.zeros((0, 3), np.int64), process=False)
         faces = mesh.triangle.indices.numpy().astype(np.int64)
-        colors = _to_uint8(mesh.vertex.colors.numpy())
+        colors = _to_uint8(mesh.vertex.colors.numpy()) if self.config.color else _grey(len(vertices))
         keep = vertices[:, 2] >= self.config.ground_crop_m
         faces = faces[keep[faces].all(axis=1)]
         used = np.zeros(len(vertices), bool)
@@ -212,7 +217,8 @@ class TSDFFusion:
             return trimesh.PointCloud(np.zeros((0, 3)))
         cloud = self.grid.extract_point_cloud(self._weight_threshold()).cpu()
         points = cloud.point.positions.numpy().astype(np.float64).reshape(-1, 3)
-        colors = _to_uint8(cloud.point.colors.numpy().reshape(-1, 3))
+        colors = (_to_uint8(cloud.point.colors.numpy().reshape(-1, 3)) if self.config.color
+                  else _grey(len(points)))
         keep = points[:, 2] >= self.config.ground_crop_m
         order = np.lexsort(points[keep].T[::-1])
         return trimesh.PointCloud(points[keep][order], colors=colors[keep][order])
@@ -230,6 +236,10 @@ def _canonical_faces(faces: np.ndarray) -> np.ndarray:
 
 def _to_uint8(colors: np.ndarray) -> np.ndarray:
     return np.clip(np.round(colors * 255.0), 0, 255).astype(np.uint8)
+
+
+def _grey(count: int) -> np.ndarray:
+    return np.full((count, 3), 180, np.uint8)
 
 
 def reconstruct_views(views: Iterable[tuple[np.ndarray, np.ndarray, np.ndarray]], K: np.ndarray,  # noqa: N803

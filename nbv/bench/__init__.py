@@ -10,6 +10,7 @@ from dataclasses import asdict, dataclass
 
 AREAS = (
     "render",
+    "recon",
 )
 """Bench modules under `nbv.bench`, run in this order."""
 

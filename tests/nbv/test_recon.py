@@ -78,10 +78,13 @@ def test_ground_is_cropped_by_default_and_kept_on_request(raycast_views, raycast
     assert np.any(ground & (np.abs(kept.mesh.vertices[:, 0]) > 0.8))  # ground well beyond the walls
 
 
-def test_colours_are_fused(raycast_recon) -> None:
+def test_colours_are_fused_and_optional(raycast_views, raycast_recon) -> None:
     colors = raycast_recon.mesh.visual.vertex_colors[:, :3].astype(int)
     np.testing.assert_allclose(np.median(colors, axis=0), (200, 100, 50), atol=1)
     assert raycast_recon.points.colors.shape == (len(raycast_recon.points.vertices), 4)
+    subset = [v[:3] for v in raycast_views[::6]]
+    plain = reconstruct_views(subset, CAMERA.K, ReconstructionConfig(color=False))
+    np.testing.assert_array_equal(plain.mesh.vertices, reconstruct_views(subset, CAMERA.K).mesh.vertices)
 
 
 def test_fusion_is_deterministic_and_incremental_equals_batch(raycast_views) -> None:

@@ -15,6 +15,8 @@ COMMANDS = (
     "scan",
     "reconstruct",
     "evaluate",
+    "train",
+    "plan",
     "demo",
     "bench",
 )

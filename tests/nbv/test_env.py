@@ -125,7 +125,8 @@ def test_action_rescaling_and_angle_wrap():
     step = action_to_viewpoint([1.0, -1.0, 0.5], start, relative)  # R and elevation clip to their ranges
     assert step.radius == pytest.approx(2.5) and step.azimuth == pytest.approx(0.1 - math.pi + 2 * math.pi)
     assert step.elevation == pytest.approx(0.3 + 0.25 * math.radians(75))
-    assert action_to_viewpoint([0.0, 0.0, 1.0], Viewpoint(2.0, 0.1, 1.2), relative).elevation == pytest.approx(math.radians(80))
+    high = action_to_viewpoint([0.0, 0.0, 1.0], Viewpoint(2.0, 0.1, 1.2), relative)
+    assert high.elevation == pytest.approx(math.radians(80))
     assert wrap_angle(3 * math.pi / 2) == pytest.approx(-math.pi / 2)
     assert wrap_angle(-math.pi) == pytest.approx(math.pi)
 
@@ -138,7 +139,8 @@ def test_snapshot_restore_continues_the_episode():
     b = NBVEnv(config, seed=99)
     b.restore(a.snapshot())
     resumed = b.reset()
-    assert torch.equal(resumed["pixels"], td["pixels"]) and torch.equal(resumed["viewpoints"], td["viewpoints"])
+    assert torch.equal(resumed["pixels"], td["pixels"])
+    assert torch.equal(resumed["viewpoints"], td["viewpoints"])
     action = torch.tensor([-0.3, 0.9, 0.5])
     out_a = a.step(td.clone().set("action", action))["next"]
     out_b = b.step(resumed.set("action", action))["next"]

@@ -1,0 +1,76 @@
+"""`nbv train`: tiny runs that checkpoint and resume; one worker resumes bit for bit."""
+
+from __future__ import annotations
+
+import csv
+
+import pytest
+import torch
+
+from nbv.checkpoint import CheckpointError, load_checkpoint
+from nbv.cli import main
+from nbv.env import EnvConfig
+from nbv.train import train
+from nbv.train_builders import CollectorConfig, LoggerConfig, TrainConfig
+
+TINY_ENV = ["--scene", "test_building", "--width", "64", "--height", "48", "--spp", "1", "--obs-size", "32",
+            "--max-steps", "3", "--feature-backend", "opencv"]
+
+
+def tiny(out, frames: int, **collector) -> TrainConfig:
+    env = EnvConfig(scene=("test_building",), width=64, height=48, spp=1, obs_size=32, max_steps=3,
+                    feature_backend="opencv")
+    settings = {"frames": frames, "frames_per_batch": 2, "init_random_frames": 2, "seed": 7, **collector}
+    return TrainConfig(env=env, collector=CollectorConfig(**settings),
+                       logger=LoggerConfig(out=out, checkpoint_every=1000, progress=False))
+
+
+def test_one_worker_interrupted_and_resumed_equals_uninterrupted(tmp_path):
+    train(tiny(tmp_path / "straight", 8))
+    train(tiny(tmp_path / "resumed", 4))
+    middle = load_checkpoint(tmp_path / "resumed" / "checkpoint.pt")
+    assert middle["counters"]["frames"] == 4 and middle["env"]["steps"] == 1  # stopped mid-episode
+    train(tiny(tmp_path / "resumed", 8))
+    a = load_checkpoint(tmp_path / "straight" / "checkpoint.pt")
+    b = load_checkpoint(tmp_path / "resumed" / "checkpoint.pt")
+    assert a["counters"] == b["counters"] == {"frames": 8, "updates": 8}
+    assert a["loss"].keys() == b["loss"].keys()
+    for key in a["loss"]:
+        assert torch.equal(a["loss"][key], b["loss"][key]), key
+    assert torch.equal(a["rng"]["torch"], b["rng"]["torch"])
+
+
+def test_two_worker_cli_run_writes_checkpoint_and_resumes(tmp_path):
+    run = tmp_path / "run"
+    args = ["train", *TINY_ENV, "--envs", "2", "--frames-per-batch", "2", "--init-random-frames", "2",
+            "--out", str(run), "--no-progress"]
+    assert main([*args, "--frames", "4"]) == 0
+    assert load_checkpoint(run / "checkpoint.pt")["counters"]["frames"] == 4
+    assert main([*args, "--frames", "8"]) == 0
+    state = load_checkpoint(run / "checkpoint.pt")
+    assert state["counters"] == {"frames": 8, "updates": 8}
+    assert "env" not in state  # parallel workers' episodes are not checkpointed
+    with open(run / "metrics.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert [int(r["frames"]) for r in rows] == [2, 4, 6, 8]
+    assert any((run / "tensorboard").iterdir())
+
+
+def test_resuming_with_other_settings_is_refused(tmp_path):
+    train(tiny(tmp_path / "run", 2))
+    with pytest.raises(CheckpointError, match="collector.seed: checkpoint 7, now 8"):
+        train(tiny(tmp_path / "run", 4, seed=8))
+
+
+def test_corrupt_checkpoint_in_run_folder_is_a_clear_cli_error(tmp_path, capsys):
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "checkpoint.pt").write_bytes(b"not a checkpoint")
+    assert main(["train", *TINY_ENV, "--frames", "2", "--out", str(run), "--no-progress"]) == 2
+    assert "corrupt" in capsys.readouterr().err
+
+
+def test_unknown_scene_is_a_clear_cli_error(tmp_path, capsys):
+    out = str(tmp_path / "r")
+    assert main(["train", "--scene", "no_such_scene", "--frames", "2", "--out", out, "--no-progress"]) == 2
+    assert "no_such_scene" in capsys.readouterr().err

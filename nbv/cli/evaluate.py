@@ -33,7 +33,7 @@ class EvaluateCommand:
     reference: Path | None = None
     """A reference reconstruction file (the paper's full 288-view scan)."""
     gt: str | None = None
-    """Ground truth: a mesh file, or a built-in scene name (its target mesh, ground excluded)."""
+    """Ground truth: a mesh file (as is), or a built-in scene name (its target mesh, no ground)."""
     out: Path = field(default=None)
     """Folder for metrics.json, heatmap.png and heatmap.ply."""
     overwrite: bool = False
@@ -48,10 +48,11 @@ def load_ground_truth(spec: str) -> Geometry:
     """The ground-truth surface named by a file path or a built-in scene name."""
     if Path(spec).is_file():
         return load_geometry(spec, "gt")
-    if spec in list_scenes():
+    try:
         return load_scene(spec).target_mesh()
-    raise FileNotFoundError(f"gt {spec!r} is neither a mesh file nor a built-in scene "
-                            f"({', '.join(list_scenes())})")
+    except (ValueError, FileNotFoundError) as err:
+        raise FileNotFoundError(f"gt {spec!r} is neither a mesh file nor a built-in scene "
+                                f"({', '.join(list_scenes())}): {err}") from err
 
 
 def evaluate(command: EvaluateCommand, metrics: MetricsConfig = MetricsConfig(),

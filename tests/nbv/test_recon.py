@@ -59,6 +59,7 @@ def raycast_recon(raycast_views):
 
 
 def test_full_scan_of_exact_depth_matches_ground_truth(raycast_recon, gt) -> None:
+    """Renderer-free twin of the acceptance test: exact depth of the test building, 160 x 120 px."""
     metrics = evaluate_surfaces(raycast_recon.mesh, {"gt": gt}, MetricsConfig(n_points=500_000))["gt"]
     assert metrics.coverage >= 0.95
     assert metrics.chamfer_cm <= 0.3
@@ -111,23 +112,32 @@ def test_frontal_plane_lands_at_its_depth() -> None:
     np.testing.assert_allclose(recon.mesh.vertices[:, 0], 0.5, atol=0.1 * VOXEL)
 
 
-def test_rendered_hemisphere_scan_covers_and_one_side_does_not(scene, gt, tmp_path) -> None:
-    """The acceptance scan: Mitsuba renders written as a dataset, read back, fused, measured."""
+@pytest.mark.slow
+def test_rendered_hemisphere_scan_of_a_preset_covers_and_one_side_does_not(tmp_path) -> None:
+    """The acceptance scan: Mitsuba renders of a preset written as a dataset, read back, fused, measured.
+
+    240 x 180 px, 37 views at R = 2 m (a small version of the 288-view scan): a pixel spans
+    8.6 mm on the target, about two voxels.
+    """
     from render.capture import capture_dataset
     from render.renderer import RenderSettings
 
-    path = capture_dataset(scene, CAMERA, hemisphere_scan(CAMERA, SMALL_SCAN), tmp_path / "scan",
+    preset = load_scene("medieval_tavern")
+    camera = UAVCamera(240, 180)
+    views = hemisphere_scan(camera, HemispherePlan(end_overlap=0.5, side_overlap=0.5))
+    path = capture_dataset(preset, camera, views, tmp_path / "scan",
                            RenderSettings(spp=1, integrator="direct"), progress=False)
     dataset = read_dataset(path)
+    gt = preset.target_mesh()
     full = reconstruct_dataset(dataset)
-    metrics = evaluate_surfaces(full.mesh, {"gt": gt}, MetricsConfig(n_points=500_000))["gt"]
+    metrics = evaluate_surfaces(full.mesh, {"gt": gt}, MetricsConfig())["gt"]
     assert metrics.coverage >= 0.95
     assert metrics.chamfer_cm <= 0.3
     assert np.percentile(vertex_distances(full.mesh, gt), 95) <= 2 * VOXEL
     east = [i for i, f in enumerate(dataset.frames) if math.cos(f.viewpoint.azimuth) > 0.5]
     side = reconstruct_dataset(dataset, indices=east)
     one_side = evaluate_surfaces(side.mesh, {"gt": gt}, MetricsConfig(n_points=100_000))["gt"]
-    assert one_side.coverage <= 0.9 and one_side.coverage <= metrics.coverage - 0.08
+    assert one_side.coverage <= 0.85 and one_side.coverage <= metrics.coverage - 0.1
     mesh_path, points_path = save_reconstruction(full, tmp_path / "recon")
     back = trimesh.load(mesh_path, process=False)
     np.testing.assert_allclose(back.vertices, full.mesh.vertices, atol=1e-6)

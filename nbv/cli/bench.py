@@ -6,11 +6,11 @@ import argparse
 import importlib
 import json
 import platform
-import subprocess
 import time
 from pathlib import Path
 
 from nbv.bench import AREAS, BenchResult
+from nbv.provenance import git_commit
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -30,7 +30,7 @@ def run(args: argparse.Namespace) -> int:
         results.extend(importlib.import_module(f"nbv.bench.{area}").run(args.quick))
         print(f"[bench] {area} done in {time.perf_counter() - start:.1f} s", flush=True)
     args.out.mkdir(parents=True, exist_ok=True)
-    header = {"machine": platform.processor() or platform.machine(), "commit": _commit(),
+    header = {"machine": platform.processor() or platform.machine(), "commit": git_commit(),
               "time": time.strftime("%Y-%m-%d %H:%M:%S"), "quick": args.quick}
     (args.out / "bench.json").write_text(
         json.dumps({**header, "results": [r.as_dict() for r in results]}, indent=2))
@@ -46,10 +46,3 @@ def format_table(results: list[BenchResult]) -> str:
     rows += [f"| {r.area} | {r.name} | {r.value:.4g} | {r.unit} | {r.goal} |" for r in results]
     return "\n".join(rows)
 
-
-def _commit() -> str:
-    try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
-                              text=True, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"

@@ -12,13 +12,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the `demo` sub-command."""
     p = subparsers.add_parser("demo", help="scan, refine, reconstruct and evaluate a built-in scene")
     add_config_arguments(p, DemoConfig)
-    p.set_defaults(func=lambda args: _report(run_demo(config_from_args(DemoConfig, args))))
+    p.set_defaults(func=demo)
 
 
-def _report(summary: dict) -> int:
-    print(f"scene {summary['scene']}: {summary['views']} views in {summary['dataset']}")
-    for name, path in summary["figures"].items():
-        print(f"  {name}: {path}")
-    for name, seconds in summary["timings"].items():
-        print(f"  {name}: {seconds:.1f}")
+def demo(args: argparse.Namespace) -> int:
+    """Run the demo and print its table and the pictures it wrote."""
+    config = config_from_args(DemoConfig, args)
+    results = run_demo(config)
+    print((config.out / "results.md").read_text())
+    for name, path in results["figures"].items():
+        print(f"{name}: {path}")
     return 0

@@ -35,12 +35,3 @@ def test_bad_scan_input_exits_2_with_a_message(tmp_path, capsys, args, message):
     assert main(["scan", *args, "--out", str(tmp_path / "ds")]) == 2
     assert message in capsys.readouterr().err
     assert not (tmp_path / "ds").exists()
-
-
-def test_demo_writes_its_pictures(tmp_path):
-    assert main(["demo", "--out", str(tmp_path), "--scene", "test_building", "--width", "48",
-                 "--height", "36", "--spp", "1", "--end-overlap", "0.3", "--side-overlap", "0.2"]) == 0
-    assert (tmp_path / "contact_sheet.png").stat().st_size > 0
-    assert (tmp_path / "trajectory.png").stat().st_size > 0
-    doc = json.loads((tmp_path / "full_scan" / "transforms.json").read_text())
-    assert len(doc["frames"]) > 4

@@ -70,6 +70,7 @@ def train(config: TrainConfig) -> Path:
     (run / "config.json").write_text(json.dumps(config_dict(config), indent=2))
     seed = config.collector.seed
     seed_everything(seed)
+    torch.set_num_threads(config.collector.threads)
 
     # Networks, loss, optimisers, replay buffer.
     actor, critic = make_sac_agent(config.env, config.network)

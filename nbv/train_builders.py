@@ -37,10 +37,13 @@ class CollectorConfig:
     """Steps taken with uniformly random actions before the policy acts and learning starts."""
     seed: int = 0
     """Seed of torch, numpy, Python, the envs and the Bag of Views."""
+    threads: int = 1
+    """Torch CPU threads of the learner (workers use 1 each); more threads on shared cores thrash."""
 
     def __post_init__(self) -> None:
-        if self.frames < 1 or self.envs < 1:
-            raise ValueError(f"frames and envs must be >= 1, got {self.frames}, {self.envs}")
+        if self.frames < 1 or self.envs < 1 or self.threads < 1:
+            raise ValueError(f"frames, envs and threads must be >= 1, got {self.frames}, {self.envs}, "
+                             f"{self.threads}")
         if self.frames_per_batch < self.envs or self.frames_per_batch % self.envs:
             raise ValueError(f"frames_per_batch ({self.frames_per_batch}) must be a positive multiple of "
                              f"envs ({self.envs})")

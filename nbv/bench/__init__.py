@@ -11,6 +11,7 @@ from dataclasses import asdict, dataclass
 AREAS = (
     "render",
     "recon",
+    "rl",
 )
 """Bench modules under `nbv.bench`, run in this order."""
 

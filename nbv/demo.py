@@ -81,14 +81,25 @@ def run_demo(config: DemoConfig) -> dict:
         clock = time.perf_counter()
 
     plan = HemispherePlan(end_overlap=config.end_overlap, side_overlap=config.side_overlap)
-    full = full_scan(scene, camera, out / "full_scan", RenderSettings(spp=config.spp, seed=config.seed),
-                     config.variant, plan, config.fresh)
+    full = full_scan(
+        scene,
+        camera,
+        out / "full_scan",
+        RenderSettings(spp=config.spp, seed=config.seed),
+        config.variant,
+        plan,
+        config.fresh,
+    )
     lap("scan_s")
     refine_config = RefineConfig(ranges=config.ranges, words=config.words, seed=config.seed)
     with tqdm(total=len(full), desc="features", unit="view") as bar:
-        refined = refine_dataset(full.root, out / "refined", refine_config, overwrite=True, progress=bar.update)
+        refined = refine_dataset(
+            full.root, out / "refined", refine_config, overwrite=True, progress=bar.update
+        )
     lap("refine_s")
-    recon_config = ReconstructionConfig(voxel_size_m=config.voxel_size_m, truncation_m=4 * config.voxel_size_m)
+    recon_config = ReconstructionConfig(
+        voxel_size_m=config.voxel_size_m, truncation_m=4 * config.voxel_size_m
+    )
     recon_full = reconstruct_dataset(full, recon_config)
     recon_refined = reconstruct_dataset(full, recon_config, refined["kept"])
     save_reconstruction(recon_full, out / "recon_full")
@@ -98,31 +109,48 @@ def run_demo(config: DemoConfig) -> dict:
     metrics_config = MetricsConfig(n_points=config.metric_points, seed=config.seed)
     metrics = {
         "full": evaluate_surfaces(recon_full.mesh, {"gt": gt}, metrics_config),
-        "refined": evaluate_surfaces(recon_refined.mesh, {"gt": gt, "reference": recon_full.mesh},
-                                     metrics_config),
+        "refined": evaluate_surfaces(
+            recon_refined.mesh, {"gt": gt, "reference": recon_full.mesh}, metrics_config
+        ),
     }
     lap("evaluate_s")
     figures = {
         "contact_sheet": contact_sheet(full, out / "contact_sheet.png"),
-        "trajectory_full": plot_trajectory(full.poses(), gt, out / "trajectory_full.png",
-                                           f"{scene.name}: full hemisphere scan"),
-        "trajectory_refined": plot_trajectory(read_dataset(out / "refined").poses(), gt,
-                                              out / "trajectory_refined.png",
-                                              f"{scene.name}: Bag of Views refinement (N={config.ranges}, "
-                                              f"W={config.words})"),
-        "heatmap_refined_vs_full": write_heatmap(recon_refined.mesh, recon_full.mesh, out,
-                                                 name="heatmap_refined_vs_full",
-                                                 title="refined vs full-scan reconstruction")[1],
-        "heatmap_full_vs_gt": write_heatmap(recon_full.mesh, gt, out, name="heatmap_full_vs_gt",
-                                            title="full-scan reconstruction vs ground truth")[1],
+        "trajectory_full": plot_trajectory(
+            full.poses(), gt, out / "trajectory_full.png", f"{scene.name}: full hemisphere scan"
+        ),
+        "trajectory_refined": plot_trajectory(
+            read_dataset(out / "refined").poses(),
+            gt,
+            out / "trajectory_refined.png",
+            f"{scene.name}: Bag of Views refinement (N={config.ranges}, W={config.words})",
+        ),
+        "heatmap_refined_vs_full": write_heatmap(
+            recon_refined.mesh,
+            recon_full.mesh,
+            out,
+            name="heatmap_refined_vs_full",
+            title="refined vs full-scan reconstruction",
+        )[1],
+        "heatmap_full_vs_gt": write_heatmap(
+            recon_full.mesh,
+            gt,
+            out,
+            name="heatmap_full_vs_gt",
+            title="full-scan reconstruction vs ground truth",
+        )[1],
     }
     lap("figures_s")
     results = {
         "config": {k: str(v) if isinstance(v, Path) else v for k, v in asdict(config).items()},
-        "commit": git_commit(), "scene": scene.name, "views_full": len(full),
-        "views_refined": len(refined["kept"]), "kept": refined["kept"],
+        "commit": git_commit(),
+        "scene": scene.name,
+        "views_full": len(full),
+        "views_refined": len(refined["kept"]),
+        "kept": refined["kept"],
         "metrics": {name: {ref: m.as_dict() for ref, m in per.items()} for name, per in metrics.items()},
-        "timings": timings, "figures": {k: str(v) for k, v in figures.items()},
+        "timings": timings,
+        "figures": {k: str(v) for k, v in figures.items()},
     }
     (out / "results.json").write_text(json.dumps(results, indent=2))
     (out / "results.md").write_text(results_table(results, metrics))
@@ -131,26 +159,34 @@ def run_demo(config: DemoConfig) -> dict:
 
 def results_table(results: dict, metrics: dict[str, dict[str, SurfaceMetrics]]) -> str:
     """The demo's Markdown table, with the paper's Table 2 range beside our numbers."""
-    rows = ["| view set | views | vs | Chamfer (cm) | Hausdorff (cm) | coverage | F-score |",
-            "| --- | ---: | --- | ---: | ---: | ---: | ---: |"]
+    rows = [
+        "| view set | views | vs | Chamfer (cm) | Hausdorff (cm) | coverage | F-score |",
+        "| --- | ---: | --- | ---: | ---: | ---: | ---: |",
+    ]
     views = {"full": results["views_full"], "refined": results["views_refined"]}
     for name, per in metrics.items():
         for ref, m in per.items():
-            rows.append(f"| {name} | {views[name]} | {ref} | {m.chamfer_cm:.3f} | {m.hausdorff_cm:.3f} | "
-                        f"{m.coverage:.3f} | {m.fscore:.3f} |")
+            rows.append(
+                f"| {name} | {views[name]} | {ref} | {m.chamfer_cm:.3f} | {m.hausdorff_cm:.3f} | "
+                f"{m.coverage:.3f} | {m.fscore:.3f} |"
+            )
     paper_views = [v for t in TABLE2.values() for v in t["views"]]
     paper_chamfer = [v for t in TABLE2.values() for v in t["chamfer_cm"]]
     paper_hausdorff = [v for t in TABLE2.values() for v in t["hausdorff_cm"]]
     reduction = 100 * (1 - results["views_refined"] / results["views_full"])
     lines = [
-        f"# Demo: {results['scene']} (commit {results['commit']})", "", *rows, "",
+        f"# Demo: {results['scene']} (commit {results['commit']})",
+        "",
+        *rows,
+        "",
         f"Ours: Bag of Views kept {results['views_refined']} of {results['views_full']} views "
         f"({reduction:.1f} % fewer).",
         f"Paper (Table 2, two buildings, 12 settings each, of {FULL_SCAN_VIEWS} views): kept "
         f"{min(paper_views)} to {max(paper_views)} views; vs the full scan Chamfer "
         f"{min(paper_chamfer):.2f} to {max(paper_chamfer):.2f} cm, Hausdorff {min(paper_hausdorff):.2f} to "
         f"{max(paper_hausdorff):.2f} cm; 70.6 % fewer views at best (Sec. VII).",
-        "", "Timings (s): " + ", ".join(f"{k} {v}" for k, v in results["timings"].items()), "",
+        "",
+        "Timings (s): " + ", ".join(f"{k} {v}" for k, v in results["timings"].items()),
+        "",
     ]
     return "\n".join(lines)
-

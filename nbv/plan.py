@@ -17,6 +17,7 @@ import hashlib
 import json
 import re
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -27,8 +28,10 @@ from nbv.cli.evaluate import EvaluateCommand, evaluate
 from nbv.env import EnvConfig, NBVEnv
 from nbv.figures import plot_trajectory
 from nbv.metrics import MetricsConfig
+from nbv.paper_numbers import FIG1_NBV
 from nbv.planners import HemispherePlanner, Planner, make_planner
 from nbv.recon import ReconstructionConfig, reconstruct_dataset, save_reconstruction
+from render.camera import UAVCamera
 from render.capture import capture_dataset
 from render.dataset import check_output_folder, read_dataset, write_json
 from render.renderer import RenderSettings
@@ -51,7 +54,7 @@ class PlanConfig:
     views: int | None = None
     """Number of views; default: the policy's episode, the whole hemisphere, or 13 (paper Fig. 1)."""
     width: int = 320
-    """Image width, pixels (policy: its training resolution is used for planning)."""
+    """Width of the captured views, pixels (a policy plans at its training resolution)."""
     height: int = 240
     """Image height, pixels."""
     spp: int = 16
@@ -126,8 +129,9 @@ def plan_scan(config: PlanConfig) -> dict:
     views, plan_s = choose_views(config, planner, env_config)
     scene = load_scene(config.scene)
     out.mkdir(parents=True, exist_ok=True)
-    dataset = capture_dataset(scene, env_config.camera, views, out / "views",
-                              RenderSettings(env_config.spp, seed=config.seed), config.variant,
+    camera = UAVCamera(config.width, config.height)
+    settings = RenderSettings(config.spp, seed=config.seed)
+    dataset = capture_dataset(scene, camera, views, out / "views", settings, config.variant,
                               {"planner": config.planner}, overwrite=True, progress=False)
     recon_config = ReconstructionConfig(config.voxel_size_m, 4 * config.voxel_size_m)
     recon = reconstruct_dataset(read_dataset(dataset), recon_config)
@@ -146,3 +150,57 @@ def plan_scan(config: PlanConfig) -> dict:
     plot_trajectory(poses, scene.target_mesh(), out / "trajectory.png",
                     title=f"{config.planner} on {config.scene}: {len(views)} views", numbered=True)
     return doc
+
+
+COMPARED = (("coverage", "gt", "coverage", 100.0), ("chamfer_cm", "reference", "chamfer_cm", 1.0),
+            ("hausdorff_cm", "reference", "hausdorff_cm", 1.0), ("chamfer_cm", "gt", "chamfer_cm", 1.0),
+            ("hausdorff_cm", "gt", "hausdorff_cm", 1.0))
+"""Table columns: (metric, against, paper Fig. 1 key, display scale)."""
+
+
+def compare_planners(base: PlanConfig, planners: Sequence[str], seeds: Sequence[int], out: str | Path) -> str:
+    """Run `plan_scan` for every planner and seed; write comparison.json and comparison.md; return the table.
+
+    Each run goes to `out/<planner>-seed<seed>/`; runs already there are read back, not redone.
+    The table gives mean +- std over seeds beside the paper's Fig. 1 (13 views, SAC policy).
+    """
+    out = Path(out)
+    runs = []
+    for planner in planners:
+        label = "policy" if planner.startswith("policy:") else planner
+        for seed in seeds:
+            folder = out / f"{label}-seed{seed}"
+            if (folder / "plan.json").is_file():
+                doc = json.loads((folder / "plan.json").read_text())
+            else:
+                run = dataclasses.replace(base, planner=planner, seed=seed, out=folder, overwrite=True)
+                doc = plan_scan(run)
+            runs.append({"planner": label, "seed": seed, **{k: doc[k] for k in ("views", "gt", "reference")}})
+    write_json(out / "comparison.json", {"scene": base.scene, "seeds": list(seeds), "runs": runs,
+                                         "paper_fig1": FIG1_NBV})
+    table = comparison_table(runs, base.scene, base.threshold_cm)
+    (out / "comparison.md").write_text(table)
+    return table
+
+
+def comparison_table(runs: list[dict], scene: str, threshold_cm: float) -> str:
+    """A Markdown table, one row per planner (mean +- std over its runs), the paper's Fig. 1 last."""
+    header = ["planner", "views", f"coverage % (gt, {threshold_cm:g} cm)", "Chamfer cm (ref)",
+              "Hausdorff cm (ref)", "Chamfer cm (gt)", "Hausdorff cm (gt)"]
+    lines = [f"Planners on {scene}: mean ± std over seeds", "", "| " + " | ".join(header) + " |",
+             "|" + "---|" * len(header)]
+    for planner in dict.fromkeys(r["planner"] for r in runs):
+        mine = [r for r in runs if r["planner"] == planner]
+        cells = [f"{planner} ({len(mine)} seeds)", _mean_std([r["views"] for r in mine], "{:.1f}")]
+        for metric, against, _, scale in COMPARED:
+            cells.append(_mean_std([scale * r[against][metric] for r in mine], "{:.2f}"))
+        lines.append("| " + " | ".join(cells) + " |")
+    paper = [f"{scale * FIG1_NBV[key]:.2f}" if against == "reference" or key == "coverage" else "-"
+             for _, against, key, scale in COMPARED]
+    lines.append("| paper Fig. 1 (SAC policy, vs 288-view scan) | 13 | " + " | ".join(paper) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def _mean_std(values: list[float], fmt: str) -> str:
+    arr = np.asarray(values, dtype=np.float64)
+    return f"{fmt.format(arr.mean())} ± {fmt.format(arr.std())}" if len(arr) > 1 else fmt.format(arr.mean())

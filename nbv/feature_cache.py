@@ -28,8 +28,8 @@ CACHE_VERSION = 1
 
 
 def default_cache_dir() -> Path:
-    """`$NBV_CACHE_DIR`, else `~/.cache/nbv/features`."""
-    return Path(os.environ.get("NBV_CACHE_DIR", Path.home() / ".cache" / "nbv" / "features"))
+    """`features/` under the project's cache root (`$NBV_CACHE_DIR`, else `~/.cache/nbv`)."""
+    return Path(os.environ.get("NBV_CACHE_DIR", Path.home() / ".cache" / "nbv")) / "features"
 
 
 def dataset_digest(dataset: ViewDataset) -> str:

@@ -13,11 +13,14 @@ import sys
 COMMANDS = (
     "scene",
     "scan",
+    "refine",
+    "refine_sweep",
     "reconstruct",
     "evaluate",
     "train",
     "plan",
     "demo",
+    "tables",
     "bench",
 )
 """Sub-command modules under `nbv.cli`, in `--help` order."""

@@ -195,6 +195,7 @@ class NBVEnv(EnvBase):
         self._features = FeatureConfig(backend=config.feature_backend, max_features=config.max_features)
         self._bov: BagOfViews | None = None
         self._resume_pending = False
+        self._view: Viewpoint | None = None
         self._set_seed(seed)
 
     # -- TorchRL hooks -------------------------------------------------------------------------
@@ -252,12 +253,14 @@ class NBVEnv(EnvBase):
         return self._bov
 
     @property
-    def viewpoint(self) -> Viewpoint:
-        """The current camera viewpoint."""
+    def viewpoint(self) -> Viewpoint | None:
+        """The current camera viewpoint (None before the first reset)."""
         return self._view
 
     def snapshot(self) -> dict[str, Any]:
         """The env's full runtime state (episode, histories, RNG, BoV), loadable with weights_only."""
+        if self._view is None:
+            raise RuntimeError("NBVEnv.snapshot needs an episode: call reset() first")
         return {
             "seed": self._seed, "episode": self._episode, "views_rendered": self._views_rendered,
             "rng": self._rng.bit_generator.state, "scene": self._scene,

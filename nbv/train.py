@@ -24,7 +24,10 @@ from dataclasses import asdict
 from pathlib import Path
 
 import torch
+from tensordict import TensorDictBase
 from torch.utils.tensorboard import SummaryWriter
+from torchrl.data import ReplayBuffer
+from torchrl.objectives import SACLoss
 from tqdm import tqdm
 
 from nbv.checkpoint import (
@@ -150,8 +153,8 @@ def train(config: TrainConfig) -> Path:
     return ckpt_path
 
 
-def sac_update(loss_module, optim_actor: torch.optim.Optimizer, optim_critic: torch.optim.Optimizer,
-               sample) -> dict[str, float]:
+def sac_update(loss_module: SACLoss, optim_actor: torch.optim.Optimizer, optim_critic: torch.optim.Optimizer,
+               sample: TensorDictBase) -> dict[str, float]:
     """One SAC gradient step on a replay sample (alpha fixed: its loss is not optimised)."""
     losses = loss_module(sample)
     optim_critic.zero_grad()
@@ -163,8 +166,9 @@ def sac_update(loss_module, optim_actor: torch.optim.Optimizer, optim_critic: to
             "entropy": losses["entropy"].item()}
 
 
-def write_checkpoint(path: Path, config: TrainConfig, loss_module, optim_actor, optim_critic, buffer,
-                     frames: int, updates: int, env: NBVEnv | None) -> Path:
+def write_checkpoint(path: Path, config: TrainConfig, loss_module: SACLoss,
+                     optim_actor: torch.optim.Optimizer, optim_critic: torch.optim.Optimizer,
+                     buffer: ReplayBuffer, frames: int, updates: int, env: NBVEnv | None) -> Path:
     """Save everything a resumed run needs (see the module docstring)."""
     state = {"config": json.dumps(config_dict(config)), "loss": loss_module.state_dict(),
              "optim_actor": optim_actor.state_dict(), "optim_critic": optim_critic.state_dict(),

@@ -21,6 +21,7 @@ from torchrl.objectives import SACLoss, SoftUpdate
 
 from nbv.agent import NetworkConfig, make_actor, make_critic
 from nbv.env import EnvConfig, NBVEnv
+from scenes import load_scene
 
 
 @dataclass(frozen=True)
@@ -41,7 +42,7 @@ class CollectorConfig:
     """Torch CPU threads of the learner (workers use 1 each); more threads on shared cores thrash."""
 
     def __post_init__(self) -> None:
-        if self.frames < 1 or self.envs < 1 or self.threads < 1:
+        if min(self.frames, self.envs, self.threads) < 1:
             raise ValueError(f"frames, envs and threads must be >= 1, got {self.frames}, {self.envs}, "
                              f"{self.threads}")
         if self.frames_per_batch < self.envs or self.frames_per_batch % self.envs:
@@ -110,8 +111,12 @@ class TrainConfig:
 def make_environment(config: EnvConfig, envs: int, seed: int) -> EnvBase:
     """The training env: an in-process `NBVEnv` or a `ParallelEnv` of spawned workers, returns summed.
 
-    Worker i is seeded `seed + i` and starts its scene cycle at scene i.
+    Worker i is seeded `seed + i` and starts its scene cycle at scene i. The scenes are
+    loaded once here first, so a bad scene name fails in this process with a clear message
+    rather than inside a worker.
     """
+    for spec in config.scene:
+        load_scene(spec)
     if envs == 1:
         base: EnvBase = NBVEnv(config, 0, seed)
     else:

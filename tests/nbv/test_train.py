@@ -72,5 +72,7 @@ def test_corrupt_checkpoint_in_run_folder_is_a_clear_cli_error(tmp_path, capsys)
 
 def test_unknown_scene_is_a_clear_cli_error(tmp_path, capsys):
     out = str(tmp_path / "r")
-    assert main(["train", "--scene", "no_such_scene", "--frames", "2", "--out", out, "--no-progress"]) == 2
+    args = ["train", "--scene", "test_building", "--scene", "no_such_scene", "--envs", "2", "--frames", "2",
+            "--frames-per-batch", "2", "--out", out, "--no-progress"]
+    assert main(args) == 2
     assert "no_such_scene" in capsys.readouterr().err

@@ -87,6 +87,8 @@ def train(config: TrainConfig) -> Path:
         optim_critic.load_state_dict(resumed["optim_critic"])
         buffer.load_state_dict(resumed["buffer"])
         frames, updates = int(resumed["counters"]["frames"]), int(resumed["counters"]["updates"])
+        if frames >= config.collector.frames:
+            return ckpt_path  # the budget is already spent: nothing to do
 
     # Environment and collector (random actions until init_random_frames).
     envs = config.collector.envs

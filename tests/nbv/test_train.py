@@ -31,6 +31,7 @@ def test_one_worker_interrupted_and_resumed_equals_uninterrupted(tmp_path):
     middle = load_checkpoint(tmp_path / "resumed" / "checkpoint.pt")
     assert middle["counters"]["frames"] == 4 and middle["env"]["steps"] == 1  # stopped mid-episode
     train(tiny(tmp_path / "resumed", 8))
+    train(tiny(tmp_path / "resumed", 8))  # budget spent: a no-op
     a = load_checkpoint(tmp_path / "straight" / "checkpoint.pt")
     b = load_checkpoint(tmp_path / "resumed" / "checkpoint.pt")
     assert a["counters"] == b["counters"] == {"frames": 8, "updates": 8}

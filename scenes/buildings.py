@@ -168,8 +168,13 @@ class _Assembly:
             if i in s.timber_storeys:
                 for f in self.frames(i):
                     n = max(1, int(f.length / s.bay_w))
-                    timber_frame(b, f, self.z[i + 1] - self.z[i], [f.length * k / n for k in range(n + 1)],
-                                 self._sill(i) - self.z[i] - 0.15)
+                    timber_frame(
+                        b,
+                        f,
+                        self.z[i + 1] - self.z[i],
+                        [f.length * k / n for k in range(n + 1)],
+                        self._sill(i) - self.z[i] - 0.15,
+                    )
         if self.rects:
             self.roof()
 
@@ -190,10 +195,18 @@ class _Assembly:
         else:
             main = self.rects[0]
             for i in range(1, s.storeys):
-                eave_skirt(b, _grow(main, self.grow(i - 1)), _grow(main, self.grow(i)), self.z[i],
-                           0.6 * s.pitch_deg, s.overhang)
+                eave_skirt(
+                    b,
+                    _grow(main, self.grow(i - 1)),
+                    _grow(main, self.grow(i)),
+                    self.z[i],
+                    0.6 * s.pitch_deg,
+                    s.overhang,
+                )
             hip_roof(b, _grow(main, g), top, s.pitch_deg, s.overhang)
-            eave_brackets(b, _grow(main, g + 0.5 * s.overhang), top - s.overhang * math.tan(math.radians(s.pitch_deg)))
+            eave_brackets(
+                b, _grow(main, g + 0.5 * s.overhang), top - s.overhang * math.tan(math.radians(s.pitch_deg))
+            )
 
     def roof_top(self) -> float:
         s = self.spec
@@ -208,20 +221,29 @@ class _Assembly:
         levels = s.storeys + (0 if s.footprint == "tower" else 1)
         z_top = self.base + s.plinth_h + levels * s.storey_h
         ring = regular_polygon(self.tower_c, s.tower_radius, TOWER_SIDES)
-        b.add(prism(regular_polygon(self.tower_c, s.tower_radius + 0.15, TOWER_SIDES), self.base,
-                    self.base + s.plinth_h), "plinth")
+        b.add(
+            prism(
+                regular_polygon(self.tower_c, s.tower_radius + 0.15, TOWER_SIDES),
+                self.base,
+                self.base + s.plinth_h,
+            ),
+            "plinth",
+        )
         b.add(prism(ring, self.base, z_top), s.wall_roles[0])
         for i in range(1, levels):
             zi = self.base + s.plinth_h + i * s.storey_h
-            b.add(prism(regular_polygon(self.tower_c, s.tower_radius + 0.1, TOWER_SIDES), zi - 0.14, zi + 0.08),
-                  "trim")
+            b.add(
+                prism(regular_polygon(self.tower_c, s.tower_radius + 0.1, TOWER_SIDES), zi - 0.14, zi + 0.08),
+                "trim",
+            )
         cone_roof(b, self.tower_c, s.tower_radius, TOWER_SIDES, z_top, 55.0, 0.5)
         for i in range(levels):
             zi = self.base + (s.plinth_h + 0.9 if i == 0 else s.plinth_h + i * s.storey_h + 0.9)
             for k, f in enumerate(wall_frames(ring, self.base)):
                 mid = f.point(f.length / 2, 1.0, 0.0)
-                if (k + i) % 2 or any(r[0] - 0.5 < mid[0] < r[2] + 0.5 and r[1] - 0.5 < mid[1] < r[3] + 0.5
-                                      for r in self.rects):
+                if (k + i) % 2 or any(
+                    r[0] - 0.5 < mid[0] < r[2] + 0.5 and r[1] - 0.5 < mid[1] < r[3] + 0.5 for r in self.rects
+                ):
                     continue
                 if i == 0 and s.footprint == "tower" and k == TOWER_SIDES - 4:
                     self._door(f, f.length / 2)
@@ -251,7 +273,9 @@ class _Assembly:
                     glazed_door = i in s.balcony_storeys and self._has_balcony(f)
                     z0 = self.z[i] + 0.02 if glazed_door else self._sill(i)
                     z1 = z0 + (2.2 if glazed_door else s.window[1])
-                    self.openings.append(Opening(f, u, s.window[0], z0, z1, shutters=s.shutters and not glazed_door))
+                    self.openings.append(
+                        Opening(f, u, s.window[0], z0, z1, shutters=s.shutters and not glazed_door)
+                    )
 
     def _has_balcony(self, f: WallFrame) -> bool:
         s = self.spec
@@ -284,24 +308,39 @@ class _Assembly:
         if s.steps and rise > 0.05 and not s.platform:
             for k in range(s.steps):
                 out = reach + (s.steps - k) * 0.34
-                b.add(f.box((u - 1.0 - 0.1 * (s.steps - k), u + 1.0 + 0.1 * (s.steps - k)), (-0.1, out),
-                            (0.0, rise * (k + 1) / s.steps)), "steps")
+                b.add(
+                    f.box(
+                        (u - 1.0 - 0.1 * (s.steps - k), u + 1.0 + 0.1 * (s.steps - k)),
+                        (-0.1, out),
+                        (0.0, rise * (k + 1) / s.steps),
+                    ),
+                    "steps",
+                )
         if s.porch:
             top = rise + 2.3 + 0.55
-            plate = [f.point(uu, nn, zz) for uu in (u - 1.3, u + 1.3)
-                     for (nn, zz) in ((-0.05, top), (-0.05, top + 0.18), (1.9, top - 0.55), (1.9, top - 0.37))]
+            plate = [
+                f.point(uu, nn, zz)
+                for uu in (u - 1.3, u + 1.3)
+                for (nn, zz) in ((-0.05, top), (-0.05, top + 0.18), (1.9, top - 0.55), (1.9, top - 0.37))
+            ]
             b.add(hull(np.array(plate)), "roof")
             for side in (-1, 1):
-                b.add(f.box((u + side * 1.1 - 0.09, u + side * 1.1 + 0.09), (1.55, 1.73), (0.0, top - 0.45)),
-                      "beams")
+                b.add(
+                    f.box((u + side * 1.1 - 0.09, u + side * 1.1 + 0.09), (1.55, 1.73), (0.0, top - 0.45)),
+                    "beams",
+                )
 
     def _colonnade(self) -> None:
         s, b = self.spec, self.b
         x0, y0, x1, y1 = _grow(self.rects[0], 1.3)
         z_top = self.z[1] - s.overhang * math.tan(math.radians(0.6 * s.pitch_deg)) + 0.05
         spots = set()
-        for a, c, count in (((x0, y0), (x1, y0), 6), ((x0, y1), (x1, y1), 6), ((x0, y0), (x0, y1), 4),
-                            ((x1, y0), (x1, y1), 4)):
+        for a, c, count in (
+            ((x0, y0), (x1, y0), 6),
+            ((x0, y1), (x1, y1), 6),
+            ((x0, y0), (x0, y1), 4),
+            ((x1, y0), (x1, y1), 4),
+        ):
             for k in range(count + 1):
                 t = k / count
                 spots.add((round(a[0] + t * (c[0] - a[0]), 6), round(a[1] + t * (c[1] - a[1]), 6)))
@@ -317,14 +356,18 @@ class _Assembly:
         s = self.spec
         if not s.platform:
             return
-        x0, y0, _, _ = _grow(self.rects[0] if self.rects else (-s.tower_radius,) * 2 + (s.tower_radius,) * 2,
-                            s.platform * 0.7 + 0.5)
+        x0, y0, _, _ = _grow(
+            self.rects[0] if self.rects else (-s.tower_radius,) * 2 + (s.tower_radius,) * 2,
+            s.platform * 0.7 + 0.5,
+        )
         count = 3 * s.platform
         for k in range(count):
             y = y0 - (count - k) * 0.35
             self.b.add(box((-2.0, y, 0.0), (2.0, y0 + 0.05, (k + 1) * self.base / count)), "steps")
-        x0, y0, x1, y1 = _grow(self.rects[0] if self.rects else (-s.tower_radius,) * 2 + (s.tower_radius,) * 2,
-                               s.platform * 0.7 + 0.3)
+        x0, y0, x1, y1 = _grow(
+            self.rects[0] if self.rects else (-s.tower_radius,) * 2 + (s.tower_radius,) * 2,
+            s.platform * 0.7 + 0.3,
+        )
         for f in wall_frames(np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]), self.base):
             gap = (f.length / 2 - 2.3, f.length / 2 + 2.3) if f.n[1] < -0.9 else (0.0, 0.0)
             for k in range(int(f.length / 0.6) + 1):
@@ -346,12 +389,29 @@ class _Assembly:
             chimney(self.b, x, y, self.z[-1] - 0.5, top)
 
     def ruin(self) -> None:
-        x1, y0 = self.spec.width / 2, -self.spec.depth / 2
+        """Break away the front-left top corner in jagged steps.
+
+        Each cut is a slanted block reaching far out past the corner and up into
+        the sky, so every broken face opens onto the outside (no hidden pits).
+        """
+        x0, y0 = -self.spec.width / 2, -self.spec.depth / 2
         top = self.z[-1]
-        for k in range(4):
-            c = np.array([x1 - 0.5 - 1.2 * k, y0 + 1.0 + 1.6 * k, top + 0.2 - 0.5 * k])
-            corners = c + self.rng.uniform(-1.0, 1.0, (8, 3)) * np.array([1.6, 1.6, 1.4])
-            self.b.cut(hull(corners), "broken")
+        for k, (reach, drop) in enumerate(((1.2, 3.2), (2.4, 1.9), (3.6, 0.9))):
+            inner = [
+                (
+                    x0 + reach * self.rng.uniform(0.7, 1.3),
+                    y0 + reach * self.rng.uniform(0.7, 1.3),
+                    top - drop * self.rng.uniform(0.8, 1.2),
+                )
+                for _ in range(4)
+            ]
+            far = [
+                (x0 - 4.0, y0 - 4.0, top + 12.0),
+                (x0 + reach, y0 - 4.0, top + 12.0),
+                (x0 - 4.0, y0 + reach, top + 12.0),
+                (x0 - 4.0, y0 - 4.0, top - drop),
+            ]
+            self.b.cut(hull(np.array(inner + far)), "broken")
 
 
 def build_building(name: str, spec: BuildingSpec, seed: int = 0) -> Scene:

@@ -7,7 +7,7 @@ from pathlib import Path
 
 
 def cache_dir() -> Path:
-    """The cache root: `$NBV_CACHE_DIR`, else `~/.cache/nbv`; created on demand."""
-    root = Path(os.environ.get("NBV_CACHE_DIR", Path.home() / ".cache" / "nbv"))
+    """The cache root: `$NBV_CACHE_DIR` (if set and not empty), else `~/.cache/nbv`; created on demand."""
+    root = Path(os.environ.get("NBV_CACHE_DIR") or Path.home() / ".cache" / "nbv")
     root.mkdir(parents=True, exist_ok=True)
     return root

@@ -41,11 +41,13 @@ def load_scene(spec: str, up_axis: str = "z") -> Scene:
     if spec in BUILTIN:
         return BUILTIN[spec]()
     if spec.startswith(RANDOM_PREFIX):
-        seed = spec[len(RANDOM_PREFIX):]
+        seed = spec[len(RANDOM_PREFIX) :]
         if not seed.isdigit():
             raise ValueError(f"bad scene {spec!r}: expected random:SEED with SEED a non-negative integer")
         return build_random(int(seed))
     if is_scene_file(spec):
         return load_file_scene(spec, up_axis)
-    raise ValueError(f"unknown scene {spec!r}; built-in scenes: {', '.join(list_scenes())}; "
-                     f"or random:SEED, or a mesh / Mitsuba XML file path")
+    raise ValueError(
+        f"unknown scene {spec!r}; built-in scenes: {', '.join(list_scenes())}; "
+        f"or random:SEED, or a mesh / Mitsuba XML file path"
+    )

@@ -52,7 +52,9 @@ def _z(opening: Opening, z0: float, z1: float) -> tuple[float, float]:
 def cut_opening(builder: SolidBuilder, o: Opening) -> None:
     """Cut the opening's recess into everything built so far (its sides get the `reveal` role)."""
     half = o.width / 2
-    builder.cut(o.frame.box((o.u - half, o.u + half), (-RECESS_M - 0.05, o.reach), _z(o, o.z0, o.z1)), "reveal")
+    builder.cut(
+        o.frame.box((o.u - half, o.u + half), (-RECESS_M - 0.05, o.reach), _z(o, o.z0, o.z1)), "reveal"
+    )
 
 
 def fit_opening(builder: SolidBuilder, o: Opening) -> None:
@@ -63,11 +65,21 @@ def fit_opening(builder: SolidBuilder, o: Opening) -> None:
         builder.add(f.box((u - half - 0.01, u + half + 0.01), back, _z(o, o.z0 - 0.01, o.z1 + 0.01)), "door")
         for k in range(1, 4):
             zc = o.z0 + k * (o.z1 - o.z0) / 4
-            builder.add(f.box((u - half + 0.05, u + half - 0.05), (-RECESS_M - 0.01, -RECESS_M + 0.04),
-                              _z(o, zc - 0.05, zc + 0.05)), "door")
+            builder.add(
+                f.box(
+                    (u - half + 0.05, u + half - 0.05),
+                    (-RECESS_M - 0.01, -RECESS_M + 0.04),
+                    _z(o, zc - 0.05, zc + 0.05),
+                ),
+                "door",
+            )
         for side in (-1, 1):
-            builder.add(f.box(_span(u + side * (half + 0.06), 0.12), (-0.02, 0.07), _z(o, o.z0, o.z1 + 0.12)), "trim")
-        builder.add(f.box((u - half - 0.12, u + half + 0.12), (-0.02, 0.09), _z(o, o.z1, o.z1 + 0.16)), "trim")
+            builder.add(
+                f.box(_span(u + side * (half + 0.06), 0.12), (-0.02, 0.07), _z(o, o.z0, o.z1 + 0.12)), "trim"
+            )
+        builder.add(
+            f.box((u - half - 0.12, u + half + 0.12), (-0.02, 0.09), _z(o, o.z1, o.z1 + 0.16)), "trim"
+        )
         return
     builder.add(f.box((u - half - 0.01, u + half + 0.01), back, _z(o, o.z0 - 0.01, o.z1 + 0.01)), "glass")
     mullion = (-RECESS_M - 0.01, -RECESS_M + 0.05)
@@ -86,7 +98,9 @@ def fit_opening(builder: SolidBuilder, o: Opening) -> None:
             builder.add(f.box((lo, hi), (-0.02, 0.04), _z(o, o.z0, o.z1)), "shutters")
             for k in range(3):
                 zc = o.z0 + (k + 0.5) * (o.z1 - o.z0) / 3
-                builder.add(f.box((lo + 0.03, hi - 0.03), (0.03, 0.065), _z(o, zc - 0.05, zc + 0.05)), "shutters")
+                builder.add(
+                    f.box((lo + 0.03, hi - 0.03), (0.03, 0.065), _z(o, zc - 0.05, zc + 0.05)), "shutters"
+                )
 
 
 def quoins(builder: SolidBuilder, f: WallFrame, height: float, course: float = 0.32) -> None:
@@ -102,8 +116,14 @@ def _span(center: float, width: float) -> tuple[float, float]:
     return center - width / 2, center + width / 2
 
 
-def timber_frame(builder: SolidBuilder, f: WallFrame, height: float, posts: list[float],
-                 brace_top: float, width: float = 0.2) -> None:
+def timber_frame(
+    builder: SolidBuilder,
+    f: WallFrame,
+    height: float,
+    posts: list[float],
+    brace_top: float,
+    width: float = 0.2,
+) -> None:
     """Half-timbering on one storey of a wall: sill and head beams, posts at `posts`, X braces.
 
     Braces cross each panel between neighbouring posts from the sill beam up to
@@ -149,6 +169,9 @@ def balcony(builder: SolidBuilder, f: WallFrame, u0: float, u1: float, floor_z: 
 
 def _bracket(f: WallFrame, u: float, z: float, depth: float) -> mf.Manifold:
     """A triangular knee brace under a balcony slab."""
-    pts = [f.point(uu, nn, zz) for uu in (u - 0.05, u + 0.05)
-           for (nn, zz) in ((0.0, z - 0.2), (0.0, z - 0.8), (0.75 * depth, z - 0.2))]
+    pts = [
+        f.point(uu, nn, zz)
+        for uu in (u - 0.05, u + 0.05)
+        for (nn, zz) in ((0.0, z - 0.2), (0.0, z - 0.8), (0.75 * depth, z - 0.2))
+    ]
     return hull(np.array(pts))

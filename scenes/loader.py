@@ -54,8 +54,9 @@ def load_file_scene(path: str | Path, up_axis: str = "z", ground: bool = True) -
     if suffix == XML_SUFFIX:
         return Scene(name=str(path), parts=(), mitsuba_xml=path.resolve())
     if suffix not in MESH_SUFFIXES:
-        raise ValueError(f"{path}: unsupported file type {suffix!r}; use one of "
-                         f"{', '.join(MESH_SUFFIXES + (XML_SUFFIX,))}")
+        raise ValueError(
+            f"{path}: unsupported file type {suffix!r}; use one of {', '.join(MESH_SUFFIXES + (XML_SUFFIX,))}"
+        )
     raw = _read_parts(path)
     parts = list(normalise_parts(raw, up_axis))
     parts = [_with_procedural_texture(p) if p.uv is None else p for p in parts]

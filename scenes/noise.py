@@ -9,8 +9,9 @@ from __future__ import annotations
 import numpy as np
 
 
-def fbm(size: int, rng: np.random.Generator, beta: float = 2.0, low: float = 2.0,
-        high: float | None = None) -> np.ndarray:
+def fbm(
+    size: int, rng: np.random.Generator, beta: float = 2.0, low: float = 2.0, high: float | None = None
+) -> np.ndarray:
     """Fractal (1/f^beta) noise by spectral synthesis, normalised to zero mean and unit std.
 
     Args:
@@ -46,8 +47,9 @@ def anisotropic_fbm(size: int, rng: np.random.Generator, stretch: float, beta: f
     return (field - field.mean()) / (field.std() + 1e-12)
 
 
-def voronoi(size: int, cells: int, rng: np.random.Generator, jitter: float = 0.9,
-            warp: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def voronoi(
+    size: int, cells: int, rng: np.random.Generator, jitter: float = 0.9, warp: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Periodic Voronoi (worley) cells seeded one per grid cell of a `cells` x `cells` grid.
 
     Args:

@@ -47,8 +47,13 @@ def normalise_parts(parts: list[Part], up_axis: str = "z") -> tuple[Part, ...]:
     return tuple(replace(p, vertices=(v - offset) / extent) for v, p in zip(verts, parts))
 
 
-def make_ground(finish: Finish, seed: int, center: tuple[float, float] | np.ndarray = (0.0, 0.0),
-                half_m: float = 3.0, tile_m: float | None = None) -> Part:
+def make_ground(
+    finish: Finish,
+    seed: int,
+    center: tuple[float, float] | np.ndarray = (0.0, 0.0),
+    half_m: float = 3.0,
+    tile_m: float | None = None,
+) -> Part:
     """A textured square ground plane at z = 0 (not part of the target).
 
     Args:
@@ -59,8 +64,14 @@ def make_ground(finish: Finish, seed: int, center: tuple[float, float] | np.ndar
         tile_m: metres per texture tile (default: the texture's real-world tile).
     """
     cx, cy = float(center[0]), float(center[1])
-    corners = np.array([[cx - half_m, cy - half_m, 0.0], [cx + half_m, cy - half_m, 0.0],
-                        [cx + half_m, cy + half_m, 0.0], [cx - half_m, cy + half_m, 0.0]])
+    corners = np.array(
+        [
+            [cx - half_m, cy - half_m, 0.0],
+            [cx + half_m, cy - half_m, 0.0],
+            [cx + half_m, cy + half_m, 0.0],
+            [cx - half_m, cy + half_m, 0.0],
+        ]
+    )
     triangles = corners[[[0, 1, 2], [0, 2, 3]]]
     tile = tile_m or (TEXTURES[finish.texture].tile_m if finish.texture else 1.0)
     uv = triangles[..., :2] / tile

@@ -61,8 +61,9 @@ class WallFrame:
         corners = [self.point(a, b, c) for a in u for b in n for c in z]
         return hull(np.array(corners))
 
-    def beam(self, start: tuple[float, float], end: tuple[float, float], width: float,
-             n: tuple[float, float]) -> mf.Manifold:
+    def beam(
+        self, start: tuple[float, float], end: tuple[float, float], width: float, n: tuple[float, float]
+    ) -> mf.Manifold:
         """A straight beam of `width` in the wall plane from (u, z) `start` to `end`, spanning n."""
         a, b = np.array(start, float), np.array(end, float)
         axis = (b - a) / np.linalg.norm(b - a)
@@ -87,8 +88,10 @@ def wall_frames(polygon: np.ndarray, z: float) -> list[WallFrame]:
 
 def outline(rectangles: list[tuple[float, float, float, float]], grow: float = 0.0) -> list[np.ndarray]:
     """Counter-clockwise outer polygons of the union of (x0, y0, x1, y1) rectangles, grown by `grow`."""
-    section = mf.CrossSection([np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], float)
-                               for x0, y0, x1, y1 in rectangles], mf.FillRule.NonZero)
+    section = mf.CrossSection(
+        [np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], float) for x0, y0, x1, y1 in rectangles],
+        mf.FillRule.NonZero,
+    )
     if grow:
         section = section.offset(grow, mf.JoinType.Miter)
     return [_drop_collinear(np.asarray(p, dtype=np.float64)) for p in section.to_polygons()]

@@ -51,23 +51,42 @@ def planar_uv(corners: np.ndarray, tile_m: float, rotate: bool = False) -> np.nd
     return np.stack([uv[..., 1], -uv[..., 0]], -1) if rotate else uv
 
 
-def make_part(name: str, corners: np.ndarray, uv: np.ndarray | None, material: Material,
-              target: bool = True, merge: bool = True) -> Part:
+def make_part(
+    name: str,
+    corners: np.ndarray,
+    uv: np.ndarray | None,
+    material: Material,
+    target: bool = True,
+    merge: bool = True,
+) -> Part:
     """A `Part` from (F, 3, 3) corners and (F, 3, 2) UVs; corners sharing position and UV are
     merged unless `merge` is False (faster for meshes of millions of triangles)."""
     flat_uv = uv.reshape(-1, 2) if uv is not None else np.zeros((corners.size // 3, 2))
     if not merge:
         faces = np.arange(len(flat_uv), dtype=np.int64).reshape(-1, 3)
-        return Part(name, corners.reshape(-1, 3).copy(), faces, material,
-                    flat_uv.copy() if uv is not None else None, target)
+        return Part(
+            name,
+            corners.reshape(-1, 3).copy(),
+            faces,
+            material,
+            flat_uv.copy() if uv is not None else None,
+            target,
+        )
     rows = np.round(np.concatenate([corners.reshape(-1, 3), flat_uv], 1), 9)
     unique, inverse = np.unique(rows, axis=0, return_inverse=True)
-    return Part(name, unique[:, :3].copy(), inverse.reshape(-1, 3).astype(np.int64), material,
-                unique[:, 3:].copy() if uv is not None else None, target)
+    return Part(
+        name,
+        unique[:, :3].copy(),
+        inverse.reshape(-1, 3).astype(np.int64),
+        material,
+        unique[:, 3:].copy() if uv is not None else None,
+        target,
+    )
 
 
-def textured_parts(triangles: dict[str, np.ndarray], finishes: dict[str, Finish], seed: int,
-                   target: bool = True) -> list[Part]:
+def textured_parts(
+    triangles: dict[str, np.ndarray], finishes: dict[str, Finish], seed: int, target: bool = True
+) -> list[Part]:
     """One textured `Part` per role in `triangles` (role -> (F, 3, 3) corners, metres)."""
     parts = []
     for role, corners in triangles.items():

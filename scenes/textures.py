@@ -45,6 +45,7 @@ def _blend(a: np.ndarray, b: RGB, weight: np.ndarray) -> np.ndarray:
 
 def brick(base: RGB, mortar: RGB, rows: int = 16, per_row: int = 8) -> Generator:
     """Running-bond bricks with per-brick colour, chipped edges and mortar joints."""
+
     def make(size: int, rng: np.random.Generator) -> np.ndarray:
         yy, xx = np.mgrid[0:size, 0:size] / size
         row = np.floor(yy * rows).astype(int)
@@ -59,13 +60,17 @@ def brick(base: RGB, mortar: RGB, rows: int = 16, per_row: int = 8) -> Generator
         bh = size / rows
         joint = edge + rough < 0.09 * bh
         color = color * (0.8 + 0.2 * np.clip(edge / (0.25 * bh), 0, 1))[..., None]
-        color = np.where(joint[..., None], np.asarray(mortar) * (0.9 + 0.1 * rng.random((size, size, 1))), color)
+        color = np.where(
+            joint[..., None], np.asarray(mortar) * (0.9 + 0.1 * rng.random((size, size, 1))), color
+        )
         return color * _grime(size, rng, 0.12)
+
     return make
 
 
 def ashlar(base: RGB, mortar: RGB, rows: int = 6, spread: float = 0.7) -> Generator:
     """Dressed stone blocks of random widths in courses of random heights."""
+
     def make(size: int, rng: np.random.Generator) -> np.ndarray:
         heights = rng.uniform(0.7, 1.3, rows)
         row_edges = np.concatenate([[0], np.round(np.cumsum(heights) / heights.sum() * size)]).astype(int)
@@ -91,11 +96,13 @@ def ashlar(base: RGB, mortar: RGB, rows: int = 6, spread: float = 0.7) -> Genera
         joint = edge + 2.0 * fbm(size, rng, beta=1.0, low=24.0) < 4.0
         color = np.where(joint[..., None], np.asarray(mortar)[None, None, :], color)
         return color * _grime(size, rng, 0.12)
+
     return make
 
 
 def rubble(base: RGB, mortar: RGB, cells: int = 7, moss: float = 0.0) -> Generator:
     """Irregular field stones (warped Voronoi cells) in mortar, optionally overgrown with moss."""
+
     def make(size: int, rng: np.random.Generator) -> np.ndarray:
         warp = 0.22 * np.stack([fbm(size, rng, beta=3.0, low=1.0, high=12.0) for _ in range(2)])
         f1, f2, ident = voronoi(size, cells, rng, jitter=0.8, warp=warp)
@@ -107,28 +114,38 @@ def rubble(base: RGB, mortar: RGB, cells: int = 7, moss: float = 0.0) -> Generat
         color = np.where((gap < 0.07)[..., None], np.asarray(mortar)[None, None, :], color)
         if moss > 0:
             patches = np.clip(fbm(size, rng, beta=2.4, low=2.0) - (1.0 - 2.0 * moss), 0, 1)
-            color = _blend(color, (0.2, 0.33, 0.1), np.clip(patches * (0.7 + 0.6 * rng.random((size, size))), 0, 1))
+            color = _blend(
+                color, (0.2, 0.33, 0.1), np.clip(patches * (0.7 + 0.6 * rng.random((size, size))), 0, 1)
+            )
         return color * _grime(size, rng, 0.1)
+
     return make
 
 
 def plaster(base: RGB, stain: RGB) -> Generator:
     """Lime plaster: uneven trowelled surface, water stains, hairline cracks and speckle."""
+
     def make(size: int, rng: np.random.Generator) -> np.ndarray:
-        f1, f2, _ = voronoi(size, 6, rng, warp=0.3 * np.stack([fbm(size, rng, beta=3.0, high=12.0) for _ in range(2)]))
+        f1, f2, _ = voronoi(
+            size, 6, rng, warp=0.3 * np.stack([fbm(size, rng, beta=3.0, high=12.0) for _ in range(2)])
+        )
         cracks = np.clip(1.0 - (f2 - f1) / 0.02, 0, 1) * (fbm(size, rng, beta=2.0) > 0.6)
-        stains = np.clip(0.5 * fbm(size, rng, beta=2.0, low=2.0) + 0.2 * fbm(size, rng, beta=1.0, low=12.0), 0, 1)
+        stains = np.clip(
+            0.5 * fbm(size, rng, beta=2.0, low=2.0) + 0.2 * fbm(size, rng, beta=1.0, low=12.0), 0, 1
+        )
         color = _blend(np.broadcast_to(np.asarray(base), (size, size, 3)).copy(), stain, 0.6 * stains)
         color = color * (1.0 + 0.08 * fbm(size, rng, beta=1.0, low=32.0))[..., None]
         color = color * (1.0 - 0.45 * cracks)[..., None]
-        blots = (fbm(size, rng, beta=1.6, low=24.0) > 1.8)
+        blots = fbm(size, rng, beta=1.6, low=24.0) > 1.8
         color = np.where(blots[..., None], color * 0.8, color)
         return color * _grime(size, rng, 0.08)
+
     return make
 
 
 def planks(base: RGB, boards: int = 6, gap: float = 0.05, knots: int = 12) -> Generator:
     """Wooden boards running along v: grain, rings, knots and dark gaps between boards."""
+
     def make(size: int, rng: np.random.Generator) -> np.ndarray:
         yy, xx = np.mgrid[0:size, 0:size]
         bw = size / boards
@@ -141,16 +158,22 @@ def planks(base: RGB, boards: int = 6, gap: float = 0.05, knots: int = 12) -> Ge
         for _ in range(knots):
             ky, kx = rng.integers(0, size, 2)
             radius = rng.uniform(6, 16)
-            d = np.hypot(((yy - ky + size // 2) % size - size // 2) / 1.8, (xx - kx + size // 2) % size - size // 2)
+            d = np.hypot(
+                ((yy - ky + size // 2) % size - size // 2) / 1.8, (xx - kx + size // 2) % size - size // 2
+            )
             color = color * (1.0 - 0.5 * np.clip(1.0 - d / radius, 0, 1))[..., None]
         seam = np.minimum(local, bw - 1 - local) < gap * bw / 2
         color = np.where(seam[..., None], color * 0.3, color)
         return color * _grime(size, rng, 0.08)
+
     return make
 
 
-def tiles(base: RGB, rows: int = 16, per_row: int = 16, spread: float = 0.6, round_edge: bool = True) -> Generator:
+def tiles(
+    base: RGB, rows: int = 16, per_row: int = 16, spread: float = 0.6, round_edge: bool = True
+) -> Generator:
     """Overlapping roof tiles (or slates): staggered rows, shadowed lower edges, colour per tile."""
+
     def make(size: int, rng: np.random.Generator) -> np.ndarray:
         yy, xx = np.mgrid[0:size, 0:size] / size
         row = np.floor(yy * rows).astype(int)
@@ -169,11 +192,13 @@ def tiles(base: RGB, rows: int = 16, per_row: int = 16, spread: float = 0.6, rou
         lichen = np.clip(fbm(size, rng, beta=2.0, low=4.0) - 1.0, 0, 1)
         color = _blend(color, (0.55, 0.55, 0.4), 0.6 * lichen)
         return color * _grime(size, rng, 0.1)
+
     return make
 
 
 def foliage(base: RGB, dry: RGB) -> Generator:
     """Grass: vertical blades (stretched noise), patches of dry grass and dark clumps."""
+
     def make(size: int, rng: np.random.Generator) -> np.ndarray:
         blades = anisotropic_fbm(size, rng, stretch=6.0, beta=0.8)
         patches = np.clip(0.5 + 0.4 * fbm(size, rng, beta=2.2, low=2.0), 0, 1)
@@ -181,37 +206,46 @@ def foliage(base: RGB, dry: RGB) -> Generator:
         color = color * (1.0 + 0.35 * blades)[..., None]
         clumps = fbm(size, rng, beta=1.4, low=16.0) > 1.4
         return np.where(clumps[..., None], color * 0.55, color) * _grime(size, rng, 0.1)
+
     return make
 
 
 def pebbles(base: RGB, cells: int = 40) -> Generator:
     """Gravel: rounded pebbles of varied tone with dark gaps."""
+
     def make(size: int, rng: np.random.Generator) -> np.ndarray:
         f1, f2, ident = voronoi(size, cells, rng, jitter=0.9)
         shade = 0.5 + 0.8 * per_cell(ident, cells * cells, rng)
         color = np.asarray(base) * shade * (0.94 + 0.12 * per_cell(ident, cells * cells, rng, 3))
         color = color * (1.1 - 0.5 * np.clip(f1, 0, 1))[..., None]
         return np.where(((f2 - f1) < 0.08)[..., None], color * 0.35, color) * _grime(size, rng, 0.1)
+
     return make
 
 
 def glass(base: RGB) -> Generator:
     """Window glass: dark panes with sky reflections and streaks."""
+
     def make(size: int, rng: np.random.Generator) -> np.ndarray:
         reflect = np.clip(0.5 + 0.35 * fbm(size, rng, beta=2.4, low=1.0), 0, 1)
         streaks = anisotropic_fbm(size, rng, stretch=0.15, beta=1.2)
         color = np.asarray(base) * (0.6 + 0.9 * reflect + 0.15 * streaks)[..., None]
         return color * _grime(size, rng, 0.05)
+
     return make
 
 
 def paint(base: RGB, wear: RGB) -> Generator:
     """Painted or lacquered wood: a flat colour worn through to `wear` in patches, with grain."""
+
     def make(size: int, rng: np.random.Generator) -> np.ndarray:
         worn = np.clip(fbm(size, rng, beta=1.8, low=4.0) - 0.9, 0, 1)
         grain = anisotropic_fbm(size, rng, stretch=10.0, beta=1.2)
-        color = _blend(np.broadcast_to(np.asarray(base), (size, size, 3)).copy(), wear, np.clip(worn * 1.5, 0, 1))
+        color = _blend(
+            np.broadcast_to(np.asarray(base), (size, size, 3)).copy(), wear, np.clip(worn * 1.5, 0, 1)
+        )
         return color * (1.0 + 0.1 * grain)[..., None] * _grime(size, rng, 0.08)
+
     return make
 
 

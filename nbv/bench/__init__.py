@@ -10,6 +10,7 @@ from dataclasses import asdict, dataclass
 
 AREAS = (
     "render",
+    "scenes",
     "recon",
     "rl",
 )

@@ -22,6 +22,8 @@ class ScanConfig:
 
     scene: str = positional()
     """A built-in scene name (see `nbv scene list`) or a mesh / Mitsuba XML file path."""
+    up_axis: Literal["z", "y"] = "z"
+    """Up axis of a mesh file SCENE (built-in scenes are z up)."""
     out: Path = field(default=None)
     """Dataset folder to write (atomically)."""
     plan: Literal["hemisphere", "circle"] = "hemisphere"
@@ -63,7 +65,7 @@ def scan(config: ScanConfig) -> Path:
     """Render the scan the config describes and return the dataset folder."""
     camera = UAVCamera(config.width, config.height, config.focal_mm)
     views = plan_viewpoints(config, camera)
-    scene = load_scene(config.scene)
+    scene = load_scene(config.scene, config.up_axis)
     meta = {"plan": {"name": config.plan, "radius": config.radius, "end_overlap": config.end_overlap,
                      "side_overlap": config.side_overlap, "views": len(views),
                      "elevation_deg": config.elevation}}

@@ -253,7 +253,12 @@ class BagOfViews(nn.Module):
         Shape:
             - descriptors: :math:`(M, D)`.
         """
-        return float(self.scores([descriptors], [azimuth])[0])
+        x = check_descriptors(descriptors, self.dim, self.words.device)
+        r = self.range_of(azimuth)
+        k = int(self.word_count[r])
+        if x.shape[0] == 0 or k == 0:  # DESIGN 3: no keypoints -> 0; empty vocabulary -> +inf
+            return 0.0 if x.shape[0] == 0 else math.inf
+        return float(view_score(x, self.words[r, :k]))
 
     def scores(self, descriptors: Sequence[torch.Tensor | np.ndarray],
                azimuths: Sequence[float]) -> torch.Tensor:

@@ -47,6 +47,8 @@ def kmeans_plusplus(x: torch.Tensor, k: int, init: torch.Tensor | None = None,
         tensor([1., 1., 1.])
     """
     _check(x, k, init)
+    if init is not None and init.shape[0] == k:
+        return F.normalize(init, dim=1)
     chosen = [] if init is None else [F.normalize(init, dim=1)]
     count = 0 if init is None else init.shape[0]
     if count == 0:

@@ -11,6 +11,7 @@ from dataclasses import asdict, dataclass
 AREAS = (
     "render",
     "scenes",
+    "bov",
     "recon",
     "rl",
 )

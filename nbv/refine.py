@@ -19,7 +19,7 @@ from typing import Any, Literal
 import numpy as np
 import torch
 
-from nbv.bov import BagOfViews
+from nbv.bov import DEFAULT_MATCH_COSINE, BagOfViews
 from nbv.feature_cache import dataset_features
 from nbv.features import FeatureConfig, Features
 from render.dataset import ViewDataset, check_output_folder, read_dataset, write_json, write_subset
@@ -36,6 +36,9 @@ class BoVOptions:
     """Keypoints kept per view, strongest first."""
     memory_cap: int = 2048
     """Descriptors held per azimuth range (reservoir sample) for the k-means updates."""
+    match_cosine: float = DEFAULT_MATCH_COSINE
+    """c of d = 1 - cos / c: a descriptor is new below this cosine to its nearest word (0.5: the paper's
+    d = 1 - 2 cos, which keeps one view per range on SIFT; see nbv.bov)."""
     seed: int = 0
     """Seed of the reservoir and k-means++ draws."""
     device: str = "cpu"
@@ -84,7 +87,8 @@ def frame_azimuths(dataset: ViewDataset) -> np.ndarray:
 
 def refine_views(descriptors: Sequence[torch.Tensor], azimuths: Sequence[float], ranges: int,
                  words: int, memory_cap: int = 2048, seed: int = 0,
-                 device: str | torch.device | None = None) -> RefineResult:
+                 device: str | torch.device | None = None,
+                 match_cosine: float = DEFAULT_MATCH_COSINE) -> RefineResult:
     """Paper Alg. 1 over views in order: keep iff score > 0, update only with kept views.
 
     Args:
@@ -95,16 +99,19 @@ def refine_views(descriptors: Sequence[torch.Tensor], azimuths: Sequence[float],
         memory_cap: descriptors held per range.
         seed: seed of the Bag of Views.
         device: torch device of the Bag of Views.
+        match_cosine: c of the dissimilarity d = 1 - cos / c.
 
     Example:
         >>> e = torch.eye(4)
-        >>> refine_views([e[:2], e[:1], e[:0], e[2:3], e[3:4]], [0.5, 1.0, 4.0, 2.0, 3.5], 2, 1).kept
+        >>> refine_views([e[:2], e[:1], e[:0], e[2:3], e[3:4]], [0.5, 1.0, 4.0, 2.0, 3.5], 2, 1,
+        ...              match_cosine=0.5).kept
         [0, 3, 4]
     """
     if len(descriptors) != len(azimuths):
         raise ValueError(f"{len(descriptors)} views but {len(azimuths)} azimuths")
     dim = descriptors[0].shape[-1] if len(descriptors) else 128
-    bov = BagOfViews(ranges, words, memory_cap=memory_cap, seed=seed, device=device, dim=dim)
+    bov = BagOfViews(ranges, words, memory_cap=memory_cap, seed=seed, device=device, dim=dim,
+                     match_cosine=match_cosine)
     kept, scores = [], []
     for i, (desc, azimuth) in enumerate(zip(descriptors, azimuths)):
         score = bov.score(desc, float(azimuth))  # Alg. 1 lines 6-9
@@ -150,7 +157,7 @@ def refine_dataset(dataset_path: str | Path, out: str | Path, config: RefineConf
     start = time.perf_counter()
     dataset, feats, azimuths = load_views(dataset_path, config, progress)
     result = refine_views([f.descriptors for f in feats], azimuths, config.ranges, config.words,
-                          config.memory_cap, config.seed, config.device)
+                          config.memory_cap, config.seed, config.device, config.match_cosine)
     settings = {k: (str(v) if isinstance(v, Path) else v) for k, v in asdict(config).items()}
     summary = {"dataset": str(dataset_path), "source_views": len(dataset), "kept_views": len(result.kept),
                "kept": result.kept, "scores": [_json_score(s) for s in result.scores],
@@ -174,7 +181,7 @@ def kept_view_grid(descriptors: Sequence[torch.Tensor], azimuths: Sequence[float
     for n in ranges:
         for w in words:
             grid[(n, w)] = refine_views(descriptors, azimuths, n, w, options.memory_cap, options.seed,
-                                        options.device)
+                                        options.device, options.match_cosine)
             if progress is not None:
                 progress(1)
     return grid

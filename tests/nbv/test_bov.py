@@ -10,7 +10,14 @@ import pytest
 import torch
 import torch.nn.functional as F
 
-from nbv.bov import BagOfViews, quantize_cosine, view_score, vocabulary_distance
+from nbv.bov import (
+    PAPER_MATCH_COSINE,
+    BagOfViews,
+    dissimilarity,
+    quantize_cosine,
+    view_score,
+    vocabulary_distance,
+)
 
 E = torch.eye(4)
 
@@ -53,7 +60,7 @@ def test_batched_scores_equal_per_view_scores():
 
 
 def test_hand_worked_toy_from_docstring():
-    bov = BagOfViews(ranges=2, words=1, dim=4)
+    bov = BagOfViews(ranges=2, words=1, dim=4, match_cosine=PAPER_MATCH_COSINE)
     views = [(E[:2], 0.5), (E[:1], 1.0), (E[:0], 4.0), (E[2:3], 2.0), (E[3:4], 3.5)]
     scores, kept = [], []
     for i, (desc, azimuth) in enumerate(views):
@@ -70,6 +77,24 @@ def test_hand_worked_toy_from_docstring():
     assert bov.reward(E[3:4], 2.5) == pytest.approx(-math.sqrt(3), abs=1e-6)
     torch.testing.assert_close(bov.words[0, 0], torch.full((4,), 0.5))
     assert BagOfViews(ranges=2, words=1, dim=4).reward(E[:1], 0.1) == pytest.approx(0.0)
+
+
+def test_default_match_cosine_on_the_same_toy():
+    # c = 0.8: view 1's cosine 1/sqrt 2 = 0.707 to the word (e1 + e2)/sqrt 2 is below c, so it is new
+    # enough: d = 1 - 0.7071 / 0.8 = 0.1161 > 0, and it is kept (the paper's c = 0.5 drops it).
+    bov = BagOfViews(ranges=2, words=1, dim=4)
+    bov.update(E[:2], 0.5)
+    assert bov.score(E[:1], 1.0) == pytest.approx(1 - (1 / math.sqrt(2)) / 0.8, abs=1e-6)
+    assert bov.score(F.normalize(E[0] + 0.5 * E[1], dim=0)[None], 1.0) < 0  # cos 1.5 / sqrt 2.5 = 0.95
+
+
+def test_dissimilarity_generalises_the_papers_equation():
+    cos = torch.tensor([-1.0, 0.0, 0.5, 0.8, 1.0])
+    torch.testing.assert_close(dissimilarity(cos, PAPER_MATCH_COSINE), 1 - 2 * cos)
+    torch.testing.assert_close(dissimilarity(cos, 0.8), torch.tensor([2.25, 1.0, 0.375, 0.0, -0.25]))
+    for bad in (0.0, -0.5, 1.5):
+        with pytest.raises(ValueError, match="match_cosine"):
+            BagOfViews(ranges=1, words=1, match_cosine=bad)
 
 
 def test_empty_range_and_no_keypoints():
@@ -89,11 +114,11 @@ def test_reward_of_range_that_was_empty_is_w_minus_one():
 
 def test_vocabulary_distance_definitions():
     w = rand_unit(5, 8, 1)
-    assert vocabulary_distance(w, w).item() == pytest.approx(-5.0, abs=1e-5)  # all cos 1: sum of -1
+    assert vocabulary_distance(w, w, match_cosine=0.5).item() == pytest.approx(-5.0, abs=1e-5)  # cos 1: -1
     assert vocabulary_distance(w, w[:0]).item() == 5.0
     assert vocabulary_distance(w[:0], w[:0]).item() == 0.0
     ref = sum(1 - 2 * max(float(a @ b) for b in w[:2]) for a in w)
-    assert vocabulary_distance(w, w[:2]).item() == pytest.approx(ref, abs=1e-5)
+    assert vocabulary_distance(w, w[:2], match_cosine=0.5).item() == pytest.approx(ref, abs=1e-5)
 
 
 def test_range_of():
@@ -166,4 +191,4 @@ def test_view_score_masks_padding():
     x = torch.stack([E[:2], torch.stack([E[0], torch.zeros(4)])])
     mask = torch.tensor([[True, True], [True, False]])
     words = E[:1].expand(2, 1, 4)
-    torch.testing.assert_close(view_score(x, words, mask), torch.tensor([-1.0 + 1.0, -1.0]))
+    torch.testing.assert_close(view_score(x, words, mask, match_cosine=0.5), torch.tensor([-1.0 + 1.0, -1.0]))

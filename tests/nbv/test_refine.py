@@ -54,7 +54,8 @@ def source(tmp_path_factory) -> Path:
 
 
 def test_docstring_toy():
-    result = refine_views([E[:2], E[:1], E[:0], E[2:3], E[3:4]], [0.5, 1.0, 4.0, 2.0, 3.5], 2, 1)
+    result = refine_views([E[:2], E[:1], E[:0], E[2:3], E[3:4]], [0.5, 1.0, 4.0, 2.0, 3.5], 2, 1,
+                          match_cosine=0.5)
     assert result.kept == [0, 3, 4] and result.ranges == [0, 0, 1, 0, 1]
     assert result.scores[0] == math.inf and result.scores[2] == 0.0
 

@@ -99,12 +99,6 @@ def run(quick: bool) -> list[BenchResult]:
     config = EnvConfig(scene=(DEFAULT_SCENE,))
     steps = 4 if quick else 20
     results = []
-    single = env_steps_per_s(config, 1, steps)
-    double = env_steps_per_s(config, 2, steps)
-    results.append(BenchResult("rl", "env steps/s, 1 worker, 320x240 16 spp", single, "steps/s"))
-    results.append(BenchResult("rl", "env steps/s, 2 workers (ParallelEnv), 320x240 16 spp", double,
-                               "steps/s"))
-    results.append(BenchResult("rl", "2-worker speed-up over 1 worker", double / single, "x"))
     updates = sac_updates_per_s(config, 5 if quick else 50)
     results.append(BenchResult("rl", "SAC updates/s, batch 8, 64x64 frames", updates, "updates/s"))
     for backend in ("kornia", "opencv"):
@@ -115,4 +109,12 @@ def run(quick: bool) -> list[BenchResult]:
         met = "met" if total <= GOAL_PLANNING_MS else "NOT met"
         name = f"planning ms/step without rendering ({backend} SIFT + BoV + policy)"
         results.append(BenchResult("rl", name, total, "ms", f"<= {GOAL_PLANNING_MS:g}: {met}"))
+    # Env throughput last: after in-process renders and a ParallelEnv, torch ops in this process
+    # were measured 10-20x slower (thread pools left competing), which would skew the figures above.
+    single = env_steps_per_s(config, 1, steps)
+    double = env_steps_per_s(config, 2, steps)
+    results.append(BenchResult("rl", "env steps/s, 1 worker, 320x240 16 spp", single, "steps/s"))
+    results.append(BenchResult("rl", "env steps/s, 2 workers (ParallelEnv), 320x240 16 spp", double,
+                               "steps/s"))
+    results.append(BenchResult("rl", "2-worker speed-up over 1 worker", double / single, "x"))
     return results

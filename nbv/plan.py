@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 
 from nbv.cli.config_args import positional
-from nbv.cli.evaluate import EvaluateCommand, evaluate
 from nbv.env import EnvConfig, NBVEnv
+from nbv.evaluate import EvaluateCommand, evaluate
 from nbv.figures import plot_trajectory
 from nbv.metrics import MetricsConfig
 from nbv.paper_numbers import FIG1_NBV

@@ -12,6 +12,7 @@ def _git(*args: str) -> str:
 def git_commit() -> str:
     """Short hash of the checked-out commit (with '+dirty' for uncommitted changes), or 'unknown'."""
     try:
-        return _git("rev-parse", "--short", "HEAD") + ("+dirty" if _git("status", "--porcelain", "-uno") else "")
+        dirty = "+dirty" if _git("status", "--porcelain", "-uno") else ""
+        return _git("rev-parse", "--short", "HEAD") + dirty
     except (OSError, subprocess.CalledProcessError):
         return "unknown"

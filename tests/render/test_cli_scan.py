@@ -1,6 +1,5 @@
 """`nbv scan`, `nbv scene` and `nbv demo` run end to end; bad input exits 2 naming the fault."""
 
-import json
 
 import pytest
 

@@ -2,24 +2,13 @@
 
 from __future__ import annotations
 
-import cv2
 import numpy as np
 import pytest
 import torch
 from scipy.spatial import cKDTree
+from synthetic import textured
 
 from nbv.features import FeatureConfig, extract_features
-
-
-def textured(h: int, w: int, seed: int) -> np.ndarray:
-    """A multi-scale smooth-noise sRGB image: blobs at several scales, as SIFT likes."""
-    rng = np.random.default_rng(seed)
-    gray = np.zeros((h, w), np.float32)
-    for cell in (4, 8, 16):
-        noise = rng.random((h // cell + 2, w // cell + 2)).astype(np.float32)
-        gray += cv2.resize(noise, (w, h), interpolation=cv2.INTER_CUBIC) / cell**0.3
-    gray = (gray - gray.min()) / (gray.max() - gray.min())
-    return np.repeat((gray * 255).astype(np.uint8)[..., None], 3, axis=2)
 
 
 @pytest.fixture(scope="module")

@@ -6,16 +6,14 @@ Stages, each a verb: `choose_views` (the planner, on a one-worker env),
 against the ground-truth mesh (`gt`) and against the full-scan reconstruction
 (`reference`, paper Sec. V-B), and the trajectory plot. The reference is
 `--reference MESH` when given; otherwise the hemisphere scan of the same
-scene and camera is reconstructed once and cached under the cache folder
-(`$NBV_CACHE_DIR/references/`).
+scene and camera (`nbv.pipeline.full_scan`) is reconstructed once and cached
+beside that scan.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import json
-import re
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -29,15 +27,16 @@ from nbv.evaluate import EvaluateCommand, evaluate
 from nbv.figures import plot_trajectory
 from nbv.metrics import MetricsConfig
 from nbv.paper_numbers import FIG1_NBV
-from nbv.planners import HemispherePlanner, Planner, make_planner
+from nbv.pipeline import full_scan
+from nbv.planners import Planner, make_planner
 from nbv.recon import ReconstructionConfig, reconstruct_dataset, save_reconstruction
 from render.camera import UAVCamera
 from render.capture import capture_dataset
 from render.dataset import check_output_folder, read_dataset, write_json
 from render.renderer import RenderSettings
+from render.scan import HemispherePlan
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes import load_scene
-from scenes.cache import cache_dir
 
 
 @dataclass(frozen=True)
@@ -97,23 +96,22 @@ def choose_views(config: PlanConfig, planner: Planner,
 
 
 def reference_mesh(config: PlanConfig) -> Path:
-    """The full hemisphere scan's reconstruction of the scene (cached by scene, camera and settings)."""
+    """The full hemisphere scan's reconstruction (paper Sec. V-B), cached inside the cached scan's folder.
+
+    The scan comes from `nbv.pipeline.full_scan`, re-rendered only when the scene, camera or settings
+    change; a re-rendered scan replaces its folder, and the stale reconstruction with it.
+    """
     if config.reference is not None:
         return Path(config.reference)
-    key = json.dumps([config.scene, config.width, config.height, config.spp, config.voxel_size_m,
-                      config.seed])
-    digest = hashlib.sha1(key.encode()).hexdigest()[:12]
-    folder = cache_dir() / "references" / f"{re.sub(r'[^A-Za-z0-9_.-]', '_', config.scene)[:40]}-{digest}"
+    env_config = EnvConfig(scene=(config.scene,), width=config.width, height=config.height)
+    radius = (env_config.radius_min + env_config.radius_max) / 2.0
+    settings = RenderSettings(config.spp, seed=config.seed)
+    full = full_scan(load_scene(config.scene), env_config.camera, settings=settings, variant=config.variant,
+                     plan=HemispherePlan(radius=radius), progress=False)
+    folder = full.root / f"reconstruction_{config.voxel_size_m * 1000:g}mm"
     if not (folder / "mesh.ply").is_file():
-        env_config = EnvConfig(scene=(config.scene,), width=config.width, height=config.height)
-        views = HemispherePlanner().plan(NBVEnv(env_config), None)
-        scene = load_scene(config.scene)
-        capture_dataset(scene, env_config.camera, views, folder / "views",
-                        RenderSettings(config.spp, seed=config.seed), config.variant,
-                        {"planner": "hemisphere"}, overwrite=True, progress=False)
         recon_config = ReconstructionConfig(config.voxel_size_m, 4 * config.voxel_size_m)
-        recon = reconstruct_dataset(read_dataset(folder / "views"), recon_config)
-        save_reconstruction(recon, folder)
+        save_reconstruction(reconstruct_dataset(full, recon_config), folder)
     return folder / "mesh.ply"
 
 

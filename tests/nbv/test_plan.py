@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 from nbv.cli import main
+from nbv.plan import PlanConfig, reference_mesh
 from render.dataset import read_dataset
 from scenes import load_scene
 
@@ -34,3 +35,13 @@ def test_nbv_plan_end_to_end(tmp_path, capsys):
 def test_nbv_plan_unknown_planner_is_a_clear_error(tmp_path, capsys):
     assert main(["plan", "test_building", "--planner", "best", "--out", str(tmp_path / "p")]) == 2
     assert "unknown planner" in capsys.readouterr().err
+
+
+def test_reference_is_the_cached_full_scan_reconstruction(tmp_path):
+    config = PlanConfig(scene="test_building", out=tmp_path / "plan", width=48, height=36, spp=1,
+                        voxel_size_m=0.02)
+    path = reference_mesh(config)
+    assert path.name == "mesh.ply" and path.parent.name == "reconstruction_20mm"
+    assert len(read_dataset(path.parent.parent)) == 288  # the paper's full hemisphere scan
+    stamp = path.stat().st_mtime_ns
+    assert reference_mesh(config) == path and path.stat().st_mtime_ns == stamp  # reused, not rebuilt

@@ -92,11 +92,17 @@ class MitsubaRenderer:
             seed: sampler seed of the RGB pass; default: the next per-view seed.
         """
         pose = validate_pose(c2w)
-        return self.render_rgb(pose, seed), self.render_depth(pose)
+        return self._rgb(pose, seed), self._depth(pose)
 
     def render_rgb(self, c2w: np.ndarray, seed: int | None = None) -> np.ndarray:
         """The RGB pass only: H x W x 3 uint8 sRGB."""
-        pose = validate_pose(c2w)
+        return self._rgb(validate_pose(c2w), seed)
+
+    def render_depth(self, c2w: np.ndarray) -> np.ndarray:
+        """The depth pass only: H x W float32 z-depth in metres, 0 where nothing is hit in range."""
+        return self._depth(validate_pose(c2w))
+
+    def _rgb(self, pose: np.ndarray, seed: int | None) -> np.ndarray:
         if seed is None:
             seed = self.settings.view_seed(self._views_rendered)
         self._views_rendered += 1
@@ -105,9 +111,7 @@ class MitsubaRenderer:
                                spp=self.settings.spp, seed=int(seed))
         return srgb_to_uint8(np.asarray(image)[..., :3])
 
-    def render_depth(self, c2w: np.ndarray) -> np.ndarray:
-        """The depth pass only: H x W float32 z-depth in metres, 0 where nothing is hit in range."""
-        pose = validate_pose(c2w)
+    def _depth(self, pose: np.ndarray) -> np.ndarray:
         sampler = {"type": "stratified", "jitter": False}
         sensor = self._sensor(pose, "box", sampler, 1)
         aov = np.asarray(self.mi.render(self._scene, sensor=sensor,

@@ -9,9 +9,8 @@ sheet, trajectories, distance heat maps.
 
 from __future__ import annotations
 
-import json
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
@@ -22,11 +21,11 @@ from nbv.heatmap import write_heatmap
 from nbv.metrics import MetricsConfig, SurfaceMetrics, evaluate_surfaces
 from nbv.paper_numbers import FULL_SCAN_VIEWS, TABLE2
 from nbv.pipeline import full_scan
-from nbv.provenance import git_commit
+from nbv.provenance import config_record, git_commit
 from nbv.recon import ReconstructionConfig, reconstruct_dataset, save_reconstruction
 from nbv.refine import RefineConfig, refine_dataset
 from render.camera import UAVCamera
-from render.dataset import read_dataset
+from render.dataset import read_dataset, write_json
 from render.renderer import RenderSettings
 from render.scan import HemispherePlan
 from scenes import DEFAULT_SCENE, load_scene
@@ -142,7 +141,7 @@ def run_demo(config: DemoConfig) -> dict:
     }
     lap("figures_s")
     results = {
-        "config": {k: str(v) if isinstance(v, Path) else v for k, v in asdict(config).items()},
+        "config": config_record(config),
         "commit": git_commit(),
         "scene": scene.name,
         "views_full": len(full),
@@ -152,7 +151,7 @@ def run_demo(config: DemoConfig) -> dict:
         "timings": timings,
         "figures": {k: str(v) for k, v in figures.items()},
     }
-    (out / "results.json").write_text(json.dumps(results, indent=2))
+    write_json(out / "results.json", results)
     (out / "results.md").write_text(results_table(results, metrics))
     return results
 

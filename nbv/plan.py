@@ -29,6 +29,7 @@ from nbv.metrics import MetricsConfig
 from nbv.paper_numbers import FIG1_NBV
 from nbv.pipeline import full_scan
 from nbv.planners import Planner, make_planner
+from nbv.provenance import config_record
 from nbv.recon import ReconstructionConfig, reconstruct_dataset, save_reconstruction
 from render.camera import UAVCamera
 from render.capture import capture_dataset
@@ -140,7 +141,7 @@ def plan_scan(config: PlanConfig) -> dict:
     results = evaluate(command, MetricsConfig(config.metric_points, config.threshold_cm, config.seed))
     doc = {"planner": config.planner, "scene": config.scene, "views": len(views), "planning_s": plan_s,
            "viewpoints": [v.as_array().tolist() for v in views],
-           "config": json.loads(json.dumps(dataclasses.asdict(config), default=str)),
+           "config": config_record(config),
            **{name: result.as_dict() for name, result in results.items()}}
     write_json(out / "plan.json", doc)
     center = scene.center()

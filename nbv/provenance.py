@@ -2,11 +2,19 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
+from dataclasses import asdict
+from typing import Any
 
 
 def _git(*args: str) -> str:
     return subprocess.run(["git", *args], capture_output=True, text=True, check=True).stdout.strip()
+
+
+def config_record(config: Any) -> dict:
+    """A config dataclass as JSON-compatible nested dicts (tuples as lists, paths as strings)."""
+    return json.loads(json.dumps(asdict(config), default=str))
 
 
 def git_commit() -> str:

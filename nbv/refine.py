@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
@@ -22,6 +22,7 @@ import torch
 from nbv.bov import DEFAULT_MATCH_COSINE, BagOfViews
 from nbv.feature_cache import dataset_features
 from nbv.features import FeatureConfig, Features
+from nbv.provenance import config_record
 from render.dataset import ViewDataset, check_output_folder, read_dataset, write_json, write_subset
 from render.viewpoint import c2w_to_viewpoint
 
@@ -159,7 +160,7 @@ def refine_dataset(dataset_path: str | Path, out: str | Path, config: RefineConf
     dataset, feats, azimuths = load_views(dataset_path, config, progress)
     result = refine_views([f.descriptors for f in feats], azimuths, config.ranges, config.words,
                           config.memory_cap, config.seed, config.device, config.match_cosine)
-    settings = {k: (str(v) if isinstance(v, Path) else v) for k, v in asdict(config).items()}
+    settings = config_record(config)
     summary = {"dataset": str(dataset_path), "source_views": len(dataset), "kept_views": len(result.kept),
                "kept": result.kept, "scores": [_json_score(s) for s in result.scores],
                "ranges": result.ranges, "settings": settings,

@@ -12,9 +12,8 @@ labelled columns.
 from __future__ import annotations
 
 import csv
-import json
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
@@ -28,10 +27,11 @@ from nbv.heatmap import write_heatmap  # noqa: E402
 from nbv.metrics import MetricsConfig, evaluate_surfaces  # noqa: E402
 from nbv.paper_numbers import FULL_SCAN_VIEWS, TABLE2, TABLE2_RANGES, TABLE2_WORDS  # noqa: E402
 from nbv.pipeline import full_scan  # noqa: E402
-from nbv.provenance import git_commit  # noqa: E402
+from nbv.provenance import config_record, git_commit  # noqa: E402
 from nbv.recon import ReconstructionConfig, reconstruct_dataset  # noqa: E402
 from nbv.refine import BoVOptions, kept_view_grid, load_views  # noqa: E402
 from render.camera import UAVCamera  # noqa: E402
+from render.dataset import write_json  # noqa: E402
 from render.renderer import RenderSettings  # noqa: E402
 from render.scan import HemispherePlan  # noqa: E402
 from scenes import load_scene  # noqa: E402
@@ -161,9 +161,9 @@ def run_tables(config: TablesConfig) -> list[dict]:
         "command": "make tables  (nbv tables --out " + str(config.out) + ")",
         "commit": git_commit(),
         "seconds": round(time.perf_counter() - start, 1),
-        "config": {k: str(v) if isinstance(v, Path) else v for k, v in asdict(config).items()},
+        "config": config_record(config),
     }
-    (config.out / "table2.json").write_text(json.dumps({**header, "rows": rows}, indent=2))
+    write_json(config.out / "table2.json", {**header, "rows": rows})
     with open(config.out / "table2.csv", "w", newline="") as handle:
         writer = csv.DictWriter(handle, fieldnames=list(rows[-1]))
         writer.writeheader()

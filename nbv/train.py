@@ -20,7 +20,6 @@ from __future__ import annotations
 import csv
 import json
 import time
-from dataclasses import asdict
 from pathlib import Path
 
 import torch
@@ -40,6 +39,7 @@ from nbv.checkpoint import (
     set_rng_state,
 )
 from nbv.env import NBVEnv
+from nbv.provenance import config_record
 from nbv.train_builders import (
     TrainConfig,
     make_collector,
@@ -49,17 +49,13 @@ from nbv.train_builders import (
     make_replay_buffer,
     make_sac_agent,
 )
+from render.dataset import write_json
 
 CHECKPOINT = "checkpoint.pt"
 RESUMABLE_CHANGES = ("collector.frames", "logger.out", "logger.checkpoint_every", "logger.progress")
 """Settings a resumed run may change; any other difference is refused."""
 CSV_FIELDS = ("frames", "updates", "reward_mean", "episode_return", "episodes", "loss_actor", "loss_qvalue",
               "entropy", "collect_s", "update_s")
-
-
-def config_dict(config: TrainConfig) -> dict:
-    """The config as JSON-compatible nested dicts (tuples as lists, paths as strings)."""
-    return json.loads(json.dumps(asdict(config), default=str))
 
 
 def train(config: TrainConfig) -> Path:
@@ -69,8 +65,8 @@ def train(config: TrainConfig) -> Path:
     ckpt_path = run / CHECKPOINT
     resumed = load_checkpoint(ckpt_path) if ckpt_path.exists() else None
     if resumed is not None:
-        check_compatible(ckpt_path, checkpoint_config(resumed), config_dict(config), RESUMABLE_CHANGES)
-    (run / "config.json").write_text(json.dumps(config_dict(config), indent=2))
+        check_compatible(ckpt_path, checkpoint_config(resumed), config_record(config), RESUMABLE_CHANGES)
+    write_json(run / "config.json", config_record(config))
     seed = config.collector.seed
     seed_everything(seed)
     torch.set_num_threads(config.collector.threads)
@@ -172,7 +168,7 @@ def write_checkpoint(path: Path, config: TrainConfig, loss_module: SACLoss,
                      optim_actor: torch.optim.Optimizer, optim_critic: torch.optim.Optimizer,
                      buffer: ReplayBuffer, frames: int, updates: int, env: NBVEnv | None) -> Path:
     """Save everything a resumed run needs (see the module docstring)."""
-    state = {"config": json.dumps(config_dict(config)), "loss": loss_module.state_dict(),
+    state = {"config": json.dumps(config_record(config)), "loss": loss_module.state_dict(),
              "optim_actor": optim_actor.state_dict(), "optim_critic": optim_critic.state_dict(),
              "buffer": buffer.state_dict(), "counters": {"frames": frames, "updates": updates},
              "rng": rng_state()}

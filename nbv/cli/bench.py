@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import json
 import platform
 import time
 from pathlib import Path
 
 from nbv.bench import AREAS, BenchResult
 from nbv.provenance import git_commit
+from render.dataset import write_json
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -32,8 +32,7 @@ def run(args: argparse.Namespace) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     header = {"machine": platform.processor() or platform.machine(), "commit": git_commit(),
               "time": time.strftime("%Y-%m-%d %H:%M:%S"), "quick": args.quick}
-    (args.out / "bench.json").write_text(
-        json.dumps({**header, "results": [r.as_dict() for r in results]}, indent=2))
+    write_json(args.out / "bench.json", {**header, "results": [r.as_dict() for r in results]})
     table = format_table(results)
     (args.out / "bench.md").write_text(f"# Bench ({header['time']}, commit {header['commit']})\n\n{table}\n")
     print(table)

@@ -80,9 +80,88 @@ def plot_trajectory(poses: np.ndarray, mesh: trimesh.Trimesh, out: str | Path, t
     fig.colorbar(sc, ax=top, label="capture order (0 = first)")
     if title:
         fig.suptitle(title)
+    return _save(fig, out)
+
+
+
+def plot_planner_comparison(runs: Sequence[dict], paper: dict, out: str | Path, title: str = "") -> Path:
+    """Save bar charts of coverage, Chamfer and Hausdorff per planner (mean and std over seeds).
+
+    Args:
+        runs: one dict per run with `planner`, `gt` and `reference` metric dicts (`nbv plan`'s plan.json).
+        paper: the paper's Fig. 1 figures (`coverage`, `chamfer_cm`, `hausdorff_cm`), drawn as dashed lines.
+        out: PNG path.
+        title: figure title.
+    """
+    planners = list(dict.fromkeys(r["planner"] for r in runs))
+    panels = (("coverage % (vs full scan)", "reference", "coverage", 100.0),
+              ("Chamfer cm (vs full scan)", "reference", "chamfer_cm", 1.0),
+              ("Hausdorff cm (vs full scan)", "reference", "hausdorff_cm", 1.0))
+    fig, axes = plt.subplots(1, len(panels), figsize=(4.2 * len(panels), 4.2))
+    for ax, (label, against, key, scale) in zip(axes, panels):
+        values = [[scale * r[against][key] for r in runs if r["planner"] == p] for p in planners]
+        ax.bar(range(len(planners)), [np.mean(v) for v in values], yerr=[np.std(v) for v in values],
+               color="tab:blue", capsize=4)
+        ax.axhline(scale * paper[key], color="tab:red", linestyle="--", label="paper Fig. 1 (SAC)")
+        ax.set_xticks(range(len(planners)), planners, rotation=30, ha="right", fontsize=8)
+        ax.set_title(label, fontsize=10)
+        ax.legend(fontsize=8)
+    if title:
+        fig.suptitle(title)
+    return _save(fig, out)
+
+
+def training_curves(csv_path: str | Path, window: int = 500) -> dict[str, np.ndarray]:
+    """Trailing-window means of a `nbv train` metrics.csv: reward per step, return, steps per episode.
+
+    Each value at a row's `frames` averages the rows of the last `window` frames (that row included),
+    weighting each batch by its frames (reward) or its finished episodes (return); NaN where no
+    episode finished in the window.
+    """
+    table = np.genfromtxt(csv_path, delimiter=",", names=True, dtype=np.float64)
+    frames = np.atleast_1d(table["frames"])
+    per_batch = np.diff(frames, prepend=0.0)
+    episodes = np.atleast_1d(table["episodes"])
+    returns = np.nan_to_num(np.atleast_1d(table["episode_return"])) * episodes
+    weighted = {"frames": per_batch, "reward": np.atleast_1d(table["reward_mean"]) * per_batch,
+                "episodes": episodes, "returns": returns}
+    starts = np.searchsorted(frames, frames - window, side="right")
+    sums = {}
+    for name, values in weighted.items():
+        cum = np.concatenate([[0.0], np.cumsum(values)])
+        sums[name] = cum[1:] - cum[starts]
+    finished = sums["episodes"] > 0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return {"frames": frames, "reward": sums["reward"] / sums["frames"],
+                "return": np.where(finished, sums["returns"] / sums["episodes"], np.nan),
+                "steps": np.where(finished, sums["frames"] / sums["episodes"], np.nan)}
+
+
+def plot_training_curves(runs: dict[str, str | Path], out: str | Path, window: int = 500) -> Path:
+    """Save reward per step, episode return and steps per episode against frames for `nbv train` runs.
+
+    Args:
+        runs: label -> the run's metrics.csv.
+        out: PNG path.
+        window: frames averaged over for each point (`training_curves`).
+    """
+    panels = (("reward", "reward per step"), ("return", "episode return"), ("steps", "steps per episode"))
+    fig, axes = plt.subplots(1, len(panels), figsize=(13, 3.8))
+    for label, csv_path in runs.items():
+        curves = training_curves(csv_path, window)
+        for ax, (key, _) in zip(axes, panels):
+            ax.plot(curves["frames"], curves[key], label=label)
+    for ax, (_, title) in zip(axes, panels):
+        ax.set(xlabel="frames (environment steps)", title=f"{title} (last {window} frames)")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8)
+    return _save(fig, out)
+
+
+def _save(fig: plt.Figure, out: str | Path) -> Path:
+    """Lay out, write as PNG and close a figure."""
     fig.tight_layout()
     path = Path(out)
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
-

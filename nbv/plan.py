@@ -24,12 +24,12 @@ import numpy as np
 from nbv.cli.config_args import positional
 from nbv.env import EnvConfig, NBVEnv
 from nbv.evaluate import EvaluateCommand, evaluate
-from nbv.figures import plot_trajectory
+from nbv.figures import plot_planner_comparison, plot_trajectory
 from nbv.metrics import MetricsConfig
 from nbv.paper_numbers import FIG1_NBV
 from nbv.pipeline import full_scan
-from nbv.planners import Planner, make_planner
-from nbv.provenance import config_record
+from nbv.planners import Planner, make_planner, planner_label
+from nbv.provenance import config_record, git_commit
 from nbv.recon import ReconstructionConfig, reconstruct_dataset, save_reconstruction
 from render.camera import UAVCamera
 from render.capture import capture_dataset
@@ -47,7 +47,8 @@ class PlanConfig:
     scene: str = positional()
     """The target scene (a preset, random:SEED, or a mesh file)."""
     planner: str = "random"
-    """random, circle, greedy, hemisphere, or policy:CHECKPOINT (a `nbv train` checkpoint.pt)."""
+    """random, circle, greedy, hemisphere, policy:CHECKPOINT (a `nbv train` checkpoint.pt, its mode) or
+    policy-sample:CHECKPOINT (seeded draws from the policy)."""
     out: Path = field(default=None)
     """Output folder: views/, mesh.ply, points.ply, gt.ply, metrics.json, heatmap.*, trajectory.png,
     plan.json."""
@@ -151,22 +152,26 @@ def plan_scan(config: PlanConfig) -> dict:
     return doc
 
 
-COMPARED = (("coverage", "gt", "coverage", 100.0), ("chamfer_cm", "reference", "chamfer_cm", 1.0),
-            ("hausdorff_cm", "reference", "hausdorff_cm", 1.0), ("chamfer_cm", "gt", "chamfer_cm", 1.0),
-            ("hausdorff_cm", "gt", "hausdorff_cm", 1.0))
-"""Table columns: (metric, against, paper Fig. 1 key, display scale)."""
+COMPARED = (("coverage", "reference", 100.0, "coverage % (ref)"),
+            ("chamfer_cm", "reference", 1.0, "Chamfer cm (ref)"),
+            ("hausdorff_cm", "reference", 1.0, "Hausdorff cm (ref)"),
+            ("coverage", "gt", 100.0, "coverage % (gt)"),
+            ("chamfer_cm", "gt", 1.0, "Chamfer cm (gt)"),
+            ("hausdorff_cm", "gt", 1.0, "Hausdorff cm (gt)"))
+"""Table columns: (metric, against, display scale, header). The paper's Fig. 1 compares with the full scan
+(`reference`); the same metrics against the ground-truth mesh (`gt`) follow."""
 
 
 def compare_planners(base: PlanConfig, planners: Sequence[str], seeds: Sequence[int], out: str | Path) -> str:
-    """Run `plan_scan` for every planner and seed; write comparison.json and comparison.md; return the table.
+    """Run `plan_scan` for every planner and seed; write comparison.{json,md,png}; return the table.
 
-    Each run goes to `out/<planner>-seed<seed>/`; runs already there are read back, not redone.
+    Each run goes to `out/<label>-seed<seed>/` (`planner_label`); runs already there are read back.
     The table gives mean +- std over seeds beside the paper's Fig. 1 (13 views, SAC policy).
     """
     out = Path(out)
     runs = []
     for planner in planners:
-        label = "policy" if planner.startswith("policy:") else planner
+        label = planner_label(planner)
         for seed in seeds:
             folder = out / f"{label}-seed{seed}"
             if (folder / "plan.json").is_file():
@@ -175,27 +180,30 @@ def compare_planners(base: PlanConfig, planners: Sequence[str], seeds: Sequence[
                 run = dataclasses.replace(base, planner=planner, seed=seed, out=folder, overwrite=True)
                 doc = plan_scan(run)
             runs.append({"planner": label, "seed": seed, **{k: doc[k] for k in ("views", "gt", "reference")}})
-    write_json(out / "comparison.json", {"scene": base.scene, "seeds": list(seeds), "runs": runs,
-                                         "paper_fig1": FIG1_NBV})
+    write_json(out / "comparison.json", {
+        "scene": base.scene, "seeds": list(seeds), "planners": list(planners), "commit": git_commit(),
+        "config": config_record(base), "runs": runs, "paper_fig1": FIG1_NBV})
     table = comparison_table(runs, base.scene, base.threshold_cm)
     (out / "comparison.md").write_text(table)
+    plot_planner_comparison(runs, FIG1_NBV, out / "comparison.png",
+                            f"Planners on {base.scene}, {len(seeds)} seeds")
     return table
 
 
 def comparison_table(runs: list[dict], scene: str, threshold_cm: float) -> str:
     """A Markdown table, one row per planner (mean +- std over its runs), the paper's Fig. 1 last."""
-    header = ["planner", "views", f"coverage % (gt, {threshold_cm:g} cm)", "Chamfer cm (ref)",
-              "Hausdorff cm (ref)", "Chamfer cm (gt)", "Hausdorff cm (gt)"]
-    lines = [f"Planners on {scene}: mean ± std over seeds", "", "| " + " | ".join(header) + " |",
-             "|" + "---|" * len(header)]
+    header = ["planner", "views", *(label for *_, label in COMPARED)]
+    lines = [f"Planners on {scene}: mean ± std over seeds; coverage within {threshold_cm:g} cm; "
+             "ref = the full 288-view scan's reconstruction, gt = the ground-truth mesh", "",
+             "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for planner in dict.fromkeys(r["planner"] for r in runs):
         mine = [r for r in runs if r["planner"] == planner]
         cells = [f"{planner} ({len(mine)} seeds)", _mean_std([r["views"] for r in mine], "{:.1f}")]
-        for metric, against, _, scale in COMPARED:
+        for metric, against, scale, _ in COMPARED:
             cells.append(_mean_std([scale * r[against][metric] for r in mine], "{:.2f}"))
         lines.append("| " + " | ".join(cells) + " |")
-    paper = [f"{scale * FIG1_NBV[key]:.2f}" if against == "reference" or key == "coverage" else "-"
-             for _, against, key, scale in COMPARED]
+    paper = [f"{scale * FIG1_NBV[metric]:.2f}" if against == "reference" else "-"
+             for metric, against, scale, _ in COMPARED]
     lines.append("| paper Fig. 1 (SAC policy, vs 288-view scan) | 13 | " + " | ".join(paper) + " |")
     return "\n".join(lines) + "\n"
 

@@ -12,8 +12,10 @@ that need no images (random, circle, hemisphere) use only its config.
   highest Bag of Views reward (Sec. IV's reward, no learning).
 - `HemispherePlanner`: the full-coverage hemisphere scan (Sec. V-B), the
   paper's reference.
-- `PolicyPlanner`: a trained SAC actor, acting on its mode (deterministic),
-  from the env's start view.
+- `PolicyPlanner`: a trained SAC actor from the env's start view, acting on
+  its distribution's mode (`policy:CHECKPOINT`, deterministic) or on seeded
+  draws from it (`policy-sample:CHECKPOINT`, the max-entropy policy SAC
+  trained, whose action dimensions the reward does not constrain stay spread).
 """
 
 from __future__ import annotations
@@ -126,11 +128,12 @@ class GreedyBoVPlanner(Planner):
 
 
 class PolicyPlanner(Planner):
-    """A trained SAC policy (its distribution's mode) from the env's start view."""
+    """A trained SAC policy from the env's start view: its distribution's mode, or seeded draws from it."""
 
     name = "policy"
 
-    def __init__(self, checkpoint: str | Path) -> None:
+    def __init__(self, checkpoint: str | Path, sample: bool = False, seed: int = 0) -> None:
+        self.sample, self.seed = sample, seed
         state = load_checkpoint(checkpoint)
         config = checkpoint_config(state)
         self.env_config = config["env"]
@@ -157,7 +160,9 @@ class PolicyPlanner(Planner):
         self.check_env(env)
         td = env.reset()
         chosen = [env.viewpoint]
-        with torch.no_grad(), set_exploration_type(ExplorationType.DETERMINISTIC):
+        exploration = ExplorationType.RANDOM if self.sample else ExplorationType.DETERMINISTIC
+        with torch.no_grad(), set_exploration_type(exploration), torch.random.fork_rng():
+            torch.manual_seed(self.seed)
             while len(chosen) < (views or math.inf):
                 td = env.step(self.actor(td))
                 chosen.append(env.viewpoint)
@@ -169,9 +174,10 @@ class PolicyPlanner(Planner):
 
 
 def make_planner(spec: str, seed: int = 0, candidates: int = 8) -> Planner:
-    """A planner from its command-line name: random, circle, greedy, hemisphere or policy:CHECKPOINT."""
-    if spec.startswith("policy:"):
-        return PolicyPlanner(spec.split(":", 1)[1])
+    """A planner by name: random, circle, greedy, hemisphere, policy:CHECKPOINT, policy-sample:CHECKPOINT."""
+    if spec.startswith(("policy:", "policy-sample:")):
+        kind, checkpoint = spec.split(":", 1)
+        return PolicyPlanner(checkpoint, sample=kind == "policy-sample", seed=seed)
     if spec == "random":
         return RandomPlanner(seed)
     if spec == "circle":
@@ -180,5 +186,14 @@ def make_planner(spec: str, seed: int = 0, candidates: int = 8) -> Planner:
         return GreedyBoVPlanner(candidates, seed)
     if spec == "hemisphere":
         return HemispherePlanner()
-    raise ValueError(f"unknown planner {spec!r}; use random, circle, greedy, hemisphere or policy:CHECKPOINT")
+    raise ValueError(f"unknown planner {spec!r}; use random, circle, greedy, hemisphere, policy:CHECKPOINT "
+                     "or policy-sample:CHECKPOINT")
+
+
+def planner_label(spec: str) -> str:
+    """A short, file-name-safe label of a planner spec: a policy is named after its run folder."""
+    if ":" not in spec:
+        return spec
+    kind, checkpoint = spec.split(":", 1)
+    return f"{kind}-{Path(checkpoint).resolve().parent.name}"
 

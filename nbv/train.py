@@ -3,7 +3,8 @@
 The loop, top to bottom: build env, networks, loss, optimisers, buffer;
 restore the run folder's checkpoint if there is one; then collect a batch,
 store it, take gradient steps (soft-updating the target critics every
-`target_update_interval` steps), log, and checkpoint.
+`target_update_interval` steps), log, and checkpoint (with `training.png`,
+the learning curves so far).
 
 Exact resumption: checkpoints are taken between iterations and hold
 everything the rest of the run depends on: networks, optimisers, replay
@@ -39,6 +40,7 @@ from nbv.checkpoint import (
     set_rng_state,
 )
 from nbv.env import NBVEnv
+from nbv.figures import plot_training_curves
 from nbv.provenance import config_record
 from nbv.train_builders import (
     TrainConfig,
@@ -69,7 +71,8 @@ def train(config: TrainConfig) -> Path:
     write_json(run / "config.json", config_record(config))
     seed = config.collector.seed
     seed_everything(seed)
-    torch.set_num_threads(config.collector.threads)
+    if config.collector.threads:
+        torch.set_num_threads(config.collector.threads)
 
     # Networks, loss, optimisers, replay buffer.
     actor, critic = make_sac_agent(config.env, config.network)
@@ -140,6 +143,7 @@ def train(config: TrainConfig) -> Path:
 
                 if frames - last_ckpt >= config.logger.checkpoint_every or frames >= config.collector.frames:
                     csv_file.flush()
+                    plot_training_curves({run.name: csv_path}, run / "training.png")
                     write_checkpoint(ckpt_path, config, loss_module, optim_actor, optim_critic, buffer,
                                      frames, updates, env.base_env if envs == 1 else None)
                     last_ckpt = frames

@@ -38,13 +38,14 @@ class CollectorConfig:
     """Steps taken with uniformly random actions before the policy acts and learning starts."""
     seed: int = 0
     """Seed of torch, numpy, Python, the envs and the Bag of Views."""
-    threads: int = 1
-    """Torch CPU threads of the learner (workers use 1 each); more threads on shared cores thrash."""
+    threads: int = 0
+    """Torch CPU threads of the learner; 0: torch's default (one per core). The learner and an in-process
+    env take turns, so all cores help: 2 threads halved a batch-8 update on 2 idle cores (95 -> 46 ms)."""
 
     def __post_init__(self) -> None:
-        if min(self.frames, self.envs, self.threads) < 1:
-            raise ValueError(f"frames, envs and threads must be >= 1, got {self.frames}, {self.envs}, "
-                             f"{self.threads}")
+        if min(self.frames, self.envs) < 1 or self.threads < 0:
+            raise ValueError(f"frames and envs must be >= 1 and threads >= 0, got {self.frames}, "
+                             f"{self.envs}, {self.threads}")
         if self.frames_per_batch < self.envs or self.frames_per_batch % self.envs:
             raise ValueError(f"frames_per_batch ({self.frames_per_batch}) must be a positive multiple of "
                              f"envs ({self.envs})")
@@ -83,7 +84,8 @@ class LoggerConfig:
     """Run folder, logs and checkpoints."""
 
     out: Path = field(default=None)
-    """Run folder (checkpoint.pt, metrics.csv, tensorboard/, config.json); resumes its checkpoint if any."""
+    """Run folder (checkpoint.pt, metrics.csv, training.png, tensorboard/, config.json); resumes its
+    checkpoint if any."""
     checkpoint_every: int = 500
     """Environment steps between checkpoints (one is always written at the end)."""
     progress: bool = True

@@ -21,7 +21,8 @@ def main() -> None:
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     add_config_arguments(parser, PlanConfig)
     parser.add_argument("--planners", nargs="+", default=["random", "circle", "greedy"],
-                        help="planners to compare (policy:CHECKPOINT, random, circle, greedy, hemisphere)")
+                        help="planners to compare (policy:CHECKPOINT, policy-sample:CHECKPOINT, random, "
+                             "circle, greedy, hemisphere)")
     parser.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2], help="seeds per planner")
     args = parser.parse_args()
     base = config_from_args(PlanConfig, args)

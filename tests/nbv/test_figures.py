@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from nbv.figures import contact_sheet, plot_trajectory
+from nbv.figures import contact_sheet, plot_training_curves, plot_trajectory, training_curves
 from render.camera import UAVCamera
 from render.dataset import DatasetWriter, read_dataset
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
@@ -35,3 +35,15 @@ def test_trajectory_plot_is_written(dataset, tmp_path):
     path = plot_trajectory(dataset.poses(), mesh, tmp_path / "t.png", "t")
     with Image.open(path) as img:
         assert img.size[0] > 800 and img.size[1] > 400
+
+
+def test_training_curves_average_the_last_window(tmp_path):
+    csv_path = tmp_path / "metrics.csv"
+    csv_path.write_text("frames,updates,reward_mean,episode_return,episodes\n"
+                        "10,0,1.0,,0\n20,10,2.0,5.0,1\n30,20,3.0,,0\n40,30,4.0,7.0,1\n")
+    curves = training_curves(csv_path, window=20)  # each point: its own batch and the one before
+    assert curves["reward"].tolist() == pytest.approx([1.0, 1.5, 2.5, 3.5])
+    assert curves["return"][1:].tolist() == pytest.approx([5.0, 5.0, 7.0]) and np.isnan(curves["return"][0])
+    assert curves["steps"][1:].tolist() == pytest.approx([20.0, 20.0, 20.0])
+    png = plot_training_curves({"a": csv_path, "b": csv_path}, tmp_path / "curves.png", window=20)
+    assert Image.open(png).size[0] > 500

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import json
 
+from PIL import Image
+
 from nbv.cli import main
-from nbv.plan import PlanConfig, reference_mesh
+from nbv.plan import PlanConfig, compare_planners, reference_mesh
 from render.dataset import read_dataset
 from scenes import load_scene
 
@@ -45,3 +47,25 @@ def test_reference_is_the_cached_full_scan_reconstruction(tmp_path):
     assert len(read_dataset(path.parent.parent)) == 288  # the paper's full hemisphere scan
     stamp = path.stat().st_mtime_ns
     assert reference_mesh(config) == path and path.stat().st_mtime_ns == stamp  # reused, not rebuilt
+
+
+def test_compare_planners_tabulates_saved_runs(tmp_path):
+    def metrics(coverage, chamfer, hausdorff):
+        return {"coverage": coverage, "chamfer_cm": chamfer, "hausdorff_cm": hausdorff}
+
+    for seed, coverage in ((0, 0.70), (1, 0.80)):  # runs already on disk are read back, not redone
+        folder = tmp_path / f"random-seed{seed}"
+        folder.mkdir()
+        (folder / "plan.json").write_text(json.dumps({"views": 13, "gt": metrics(coverage, 0.5, 8.0),
+                                                      "reference": metrics(coverage + 0.1, 0.4, 6.0)}))
+    base = PlanConfig(scene="alpine_chalet", out=tmp_path)
+    table = compare_planners(base, ["random"], [0, 1], tmp_path)
+    row = next(line for line in table.splitlines() if line.startswith("| random"))
+    assert row == ("| random (2 seeds) | 13.0 ± 0.0 | 85.00 ± 5.00 | 0.40 ± 0.00 | 6.00 ± 0.00 "
+                   "| 75.00 ± 5.00 | 0.50 ± 0.00 | 8.00 ± 0.00 |")
+    assert table.splitlines()[-1] == ("| paper Fig. 1 (SAC policy, vs 288-view scan) | 13 | 94.60 | 0.80 "
+                                      "| 2.78 | - | - | - |")
+    saved = json.loads((tmp_path / "comparison.json").read_text())
+    assert [r["seed"] for r in saved["runs"]] == [0, 1] and saved["paper_fig1"]["coverage"] == 0.946
+    assert (tmp_path / "comparison.md").read_text() == table
+    assert Image.open(tmp_path / "comparison.png").size[0] > 500

@@ -16,6 +16,7 @@ from nbv.planners import (
     PolicyPlanner,
     RandomPlanner,
     make_planner,
+    planner_label,
 )
 from nbv.train import write_checkpoint
 from nbv.train_builders import (
@@ -104,6 +105,22 @@ def test_policy_planner_from_checkpoint(tmp_path):
     assert len(planner.plan(tiny_env(), 5)) == 5
     with pytest.raises(ValueError, match="obs_size"):
         planner.plan(NBVEnv(EnvConfig(scene=("test_building",), obs_size=16)), 2)
+
+
+def test_sampled_policy_is_seeded_and_spread(tmp_path):
+    (tmp_path / "run").mkdir()
+    save_untrained_policy(tmp_path / "run" / "checkpoint.pt", tiny_env())
+    spec = f"policy-sample:{tmp_path / 'run' / 'checkpoint.pt'}"
+    sampled = make_planner(spec, seed=1)
+    assert isinstance(sampled, PolicyPlanner) and sampled.sample
+    first = sampled.plan(tiny_env(), 4)
+    assert first == make_planner(spec, seed=1).plan(tiny_env(), 4)  # seeded: the same draws
+    assert first != make_planner(spec, seed=2).plan(tiny_env(), 4)
+    assert all(in_ranges(v, tiny_env().config) for v in first)
+    mode = make_planner(f"policy:{tmp_path / 'run' / 'checkpoint.pt'}", seed=1).plan(tiny_env(), 4)
+    assert mode != first and mode == make_planner(f"policy:{tmp_path / 'run' / 'checkpoint.pt'}",
+                                                  seed=2).plan(tiny_env(), 4)  # the mode ignores the seed
+    assert planner_label(spec) == "policy-sample-run" and planner_label("greedy") == "greedy"
 
 
 def test_bad_planner_specs():

@@ -6,6 +6,7 @@ import csv
 
 import pytest
 import torch
+from PIL import Image
 
 from nbv.checkpoint import CheckpointError, load_checkpoint
 from nbv.cli import main
@@ -55,6 +56,7 @@ def test_two_worker_cli_run_writes_checkpoint_and_resumes(tmp_path):
         rows = list(csv.DictReader(f))
     assert [int(r["frames"]) for r in rows] == [2, 4, 6, 8]
     assert any((run / "tensorboard").iterdir())
+    assert Image.open(run / "training.png").size[0] > 500
 
 
 def test_resuming_with_other_settings_is_refused(tmp_path):

@@ -9,7 +9,13 @@ Action: three values in [-1, 1]. In the paper's `absolute` mode they are the
 next viewpoint itself, rescaled to the allowed ranges of R, azimuth and
 elevation ("rescaled to conform to the specified ranges", Sec. IV); in the
 `relative` mode they are a step from the current viewpoint, at most
-`relative_step` of each range, clipped to the ranges.
+`relative_step` of each range, clipped to the ranges; in the `orbit` mode
+the azimuth is such a step and R and elevation are absolute. Orbit exists
+because absolute azimuth is a circular target that a tanh output cannot
+follow across 0 = 2 pi (moving on by 45 degrees from 350 needs an action
+jump from +1 to -1), while relative R and elevation drift to a bound and
+stay there (measured: a relative policy flew every view at R = 1.5 m,
+5 degrees up).
 
 Reward: the Bag of Views reward of the new view (vocabulary change - 1,
 DESIGN section 3). The BoV is emptied at each reset and learns the episode's
@@ -74,10 +80,12 @@ class EnvConfig:
     """Highest allowed elevation, degrees."""
     max_steps: int = 30
     """Step cap of an episode (truncation)."""
-    action_mode: Literal["absolute", "relative"] = "absolute"
-    """Action meaning: the next viewpoint (paper) or a step from the current one."""
+    action_mode: Literal["absolute", "relative", "orbit"] = "absolute"
+    """Action meaning: the next viewpoint (paper), a step from the current one, or an azimuth step with
+    absolute R and elevation (orbit)."""
     relative_step: float = 0.25
-    """Relative mode: the largest step per action, as a fraction of each range (azimuth: of 2 pi)."""
+    """Relative and orbit modes: the largest step per action, as a fraction of each range (azimuth: of
+    2 pi)."""
     bov_ranges: int = 8
     """Azimuth ranges (vocabularies) of the Bag of Views."""
     bov_words: int = 20
@@ -142,10 +150,14 @@ def action_to_viewpoint(action: Any, current: Viewpoint, config: EnvConfig) -> V
     """The next viewpoint an action asks for, under the config's action mode."""
     a = check_action(action)
     low, high = config.low, config.high
+    absolute = low + (a + 1.0) / 2.0 * (high - low)
+    step = current.as_array() + a * config.relative_step * (high - low)
     if config.action_mode == "absolute":
-        r, az, el = low + (a + 1.0) / 2.0 * (high - low)
+        r, az, el = absolute
+    elif config.action_mode == "orbit":
+        r, az, el = absolute[0], step[1], absolute[2]
     else:
-        r, az, el = current.as_array() + a * config.relative_step * (high - low)
+        r, az, el = step
         r, el = np.clip(r, low[0], high[0]), np.clip(el, low[2], high[2])
     return Viewpoint(float(r), float(az) % TWO_PI, float(el))
 

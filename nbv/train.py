@@ -122,7 +122,8 @@ def train(config: TrainConfig) -> Path:
                 losses = {}
                 if frames >= config.collector.init_random_frames:
                     for _ in range(updates_per_batch):
-                        losses = sac_update(loss_module, optim_actor, optim_critic, buffer.sample())
+                        losses = sac_update(loss_module, optim_actor, optim_critic, buffer.sample(),
+                                            config.optim.reward_scale)
                         updates += 1
                         if updates % config.optim.target_update_interval == 0:
                             target_updater.step()
@@ -156,8 +157,10 @@ def train(config: TrainConfig) -> Path:
 
 
 def sac_update(loss_module: SACLoss, optim_actor: torch.optim.Optimizer, optim_critic: torch.optim.Optimizer,
-               sample: TensorDictBase) -> dict[str, float]:
-    """One SAC gradient step on a replay sample (alpha fixed: its loss is not optimised)."""
+               sample: TensorDictBase, reward_scale: float = 1.0) -> dict[str, float]:
+    """One SAC gradient step on a replay sample, rewards scaled (alpha fixed: its loss is not optimised)."""
+    if reward_scale != 1.0:
+        sample.set(("next", "reward"), sample["next", "reward"] * reward_scale)
     losses = loss_module(sample)
     optim_critic.zero_grad()
     optim_actor.zero_grad()

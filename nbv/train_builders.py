@@ -77,6 +77,10 @@ class OptimConfig:
     """Soft update factor of the target critics."""
     updates_per_frame: float = 1.0
     """Gradient steps per collected environment step."""
+    reward_scale: float = 1.0
+    """Rewards are multiplied by this in the losses (logs keep raw rewards): the same as a temperature of
+    alpha / reward_scale. Table 1's alpha with 1.0; BoV rewards of about +-20 then leave the entropy term
+    too weak to keep the action dimensions the reward ignores spread."""
 
 
 @dataclass(frozen=True)

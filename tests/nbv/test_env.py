@@ -131,6 +131,20 @@ def test_action_rescaling_and_angle_wrap():
     assert wrap_angle(-math.pi) == pytest.approx(math.pi)
 
 
+def test_orbit_steps_the_azimuth_and_sets_radius_and_elevation():
+    orbit = EnvConfig(**{**tiny_config().__dict__, "action_mode": "orbit", "relative_step": 0.125})
+    view = action_to_viewpoint([-1.0, 1.0, 1.0], Viewpoint(2.0, 6.0, 0.3), orbit)
+    assert view.radius == pytest.approx(1.5) and view.elevation == pytest.approx(math.radians(80))
+    assert view.azimuth == pytest.approx(6.0 + math.pi / 4 - 2 * math.pi)  # one eighth of a turn, wrapped
+    back = action_to_viewpoint([0.0, -0.5, -1.0], Viewpoint(2.0, 0.1, 0.3), orbit)
+    assert back.azimuth == pytest.approx(0.1 - math.pi / 8 + 2 * math.pi)
+    assert back.radius == pytest.approx(2.0)
+    assert back.elevation == pytest.approx(math.radians(5))
+
+
+
+
+
 def test_snapshot_restore_continues_the_episode():
     config = tiny_config(max_steps=6)
     a = NBVEnv(config, seed=5)

@@ -7,12 +7,20 @@ import csv
 import pytest
 import torch
 from PIL import Image
+from tensordict import TensorDict
 
 from nbv.checkpoint import CheckpointError, load_checkpoint
 from nbv.cli import main
 from nbv.env import EnvConfig
-from nbv.train import train
-from nbv.train_builders import CollectorConfig, LoggerConfig, TrainConfig
+from nbv.train import sac_update, train
+from nbv.train_builders import (
+    CollectorConfig,
+    LoggerConfig,
+    TrainConfig,
+    make_loss_module,
+    make_optimizers,
+    make_sac_agent,
+)
 
 TINY_ENV = ["--scene", "test_building", "--width", "64", "--height", "48", "--spp", "1", "--obs-size", "32",
             "--max-steps", "3", "--feature-backend", "opencv"]
@@ -57,6 +65,29 @@ def test_two_worker_cli_run_writes_checkpoint_and_resumes(tmp_path):
     assert [int(r["frames"]) for r in rows] == [2, 4, 6, 8]
     assert any((run / "tensorboard").iterdir())
     assert Image.open(run / "training.png").size[0] > 500
+
+
+def test_reward_scale_is_the_same_update_as_scaled_rewards():
+    config = tiny(None, 10)
+
+    def one_update(rewards_times: float, reward_scale: float) -> list[torch.Tensor]:
+        torch.manual_seed(0)
+        actor, critic = make_sac_agent(config.env, config.network)
+        loss, _ = make_loss_module(actor, critic, config.optim)
+        optim_actor, optim_critic = make_optimizers(loss, config.optim)
+        n, side = 4, config.env.obs_size
+        state = {"pixels": torch.full((n, 5, side, side), 100, dtype=torch.uint8),
+                 "viewpoints": torch.zeros(n, 5, 3)}
+        sample = TensorDict({**state, "action": torch.zeros(n, 3), "next": TensorDict({
+            **state, "reward": torch.arange(n, dtype=torch.float32)[:, None] * rewards_times,
+            "done": torch.zeros(n, 1, dtype=torch.bool), "terminated": torch.zeros(n, 1, dtype=torch.bool)},
+            [n])}, [n])
+        sac_update(loss, optim_actor, optim_critic, sample, reward_scale)
+        return [p.detach().clone() for p in loss.qvalue_network_params.values(True, True)]
+
+    scaled = one_update(1.0, 0.1)
+    assert all(torch.equal(a, b) for a, b in zip(scaled, one_update(0.1, 1.0)))
+    assert not all(torch.equal(a, b) for a, b in zip(scaled, one_update(1.0, 1.0)))
 
 
 def test_resuming_with_other_settings_is_refused(tmp_path):

@@ -13,9 +13,9 @@ elevation ("rescaled to conform to the specified ranges", Sec. IV); in the
 the azimuth is such a step and R and elevation are absolute. Orbit exists
 because absolute azimuth is a circular target that a tanh output cannot
 follow across 0 = 2 pi (moving on by 45 degrees from 350 needs an action
-jump from +1 to -1), while relative R and elevation drift to a bound and
-stay there (measured: a relative policy flew every view at R = 1.5 m,
-5 degrees up).
+jump from +1 to -1), while relative R and elevation can drift to a bound
+and stay there (measured, with unscaled rewards: a relative policy flew
+every view at R = 1.5 m, 5 degrees up).
 
 Reward: the Bag of Views reward of the new view (vocabulary change - 1,
 DESIGN section 3). The BoV is emptied at each reset and learns the episode's

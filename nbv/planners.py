@@ -173,10 +173,20 @@ class PolicyPlanner(Planner):
         return chosen
 
 
+POLICY_KINDS = ("policy", "policy-sample")
+"""Spec prefixes of a trained policy: acting on its mode, or on seeded draws."""
+
+
+def split_policy_spec(spec: str) -> tuple[str, str] | None:
+    """(kind, checkpoint) of a `policy:CHECKPOINT` or `policy-sample:CHECKPOINT` spec; None for a baseline."""
+    kind, sep, checkpoint = spec.partition(":")
+    return (kind, checkpoint) if sep and kind in POLICY_KINDS else None
+
+
 def make_planner(spec: str, seed: int = 0, candidates: int = 8) -> Planner:
     """A planner by name: random, circle, greedy, hemisphere, policy:CHECKPOINT, policy-sample:CHECKPOINT."""
-    if spec.startswith(("policy:", "policy-sample:")):
-        kind, checkpoint = spec.split(":", 1)
+    if policy := split_policy_spec(spec):
+        kind, checkpoint = policy
         return PolicyPlanner(checkpoint, sample=kind == "policy-sample", seed=seed)
     if spec == "random":
         return RandomPlanner(seed)
@@ -192,8 +202,7 @@ def make_planner(spec: str, seed: int = 0, candidates: int = 8) -> Planner:
 
 def planner_label(spec: str) -> str:
     """A short, file-name-safe label of a planner spec: a policy is named after its run folder."""
-    if ":" not in spec:
-        return spec
-    kind, checkpoint = spec.split(":", 1)
-    return f"{kind}-{Path(checkpoint).resolve().parent.name}"
-
+    if policy := split_policy_spec(spec):
+        kind, checkpoint = policy
+        return f"{kind}-{Path(checkpoint).resolve().parent.name}"
+    return spec

@@ -29,6 +29,7 @@ demo: setup
 	$(VENV)/bin/nbv demo --out demo_out
 
 test: setup
+	$(VENV)/bin/ruff check .
 	$(PY) -m pytest -q
 
 bench: setup

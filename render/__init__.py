@@ -1,10 +1,22 @@
-"""The UAV camera: intrinsics, poses, Mitsuba rendering, scan plans, view datasets.
+"""The UAV camera: intrinsics, poses, Mitsuba rendering, scan plans, view datasets, scan cache.
 
 Mitsuba is imported lazily (by `render.renderer`), after the variant and the
-libLLVM path are chosen in `render.variant`.
+libLLVM path are chosen in `render.variant`; names are re-exported lazily too.
 """
 
-from render.camera import UAVCamera
-from render.viewpoint import Viewpoint, c2w_to_viewpoint, viewpoint_to_c2w
+from common.lazy import lazy_exports
 
-__all__ = ["UAVCamera", "Viewpoint", "c2w_to_viewpoint", "viewpoint_to_c2w"]
+_EXPORTS = {
+    "UAVCamera": "render.camera",
+    "Viewpoint": "render.viewpoint", "c2w_to_viewpoint": "render.viewpoint",
+    "viewpoint_to_c2w": "render.viewpoint",
+    "RenderSettings": "render.settings",
+    "MitsubaRenderer": "render.renderer",
+    "CirclePlan": "render.scan", "HemispherePlan": "render.scan", "ScanConfig": "render.scan",
+    "circle_scan": "render.scan", "hemisphere_scan": "render.scan",
+    "capture_dataset": "render.capture", "scan_dataset": "render.capture",
+    "ViewDataset": "render.dataset", "read_dataset": "render.dataset",
+    "full_scan": "render.scan_cache",
+}
+__all__ = sorted(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

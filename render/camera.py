@@ -73,3 +73,16 @@ class UAVCamera:
     def with_resolution(self, width: int, height: int) -> UAVCamera:
         """The same lens at another resolution (the field of view is kept)."""
         return UAVCamera(width, height, self.focal_mm, self.near_m, self.far_m)
+
+
+def pixel_rays(K: np.ndarray, width: int, height: int) -> np.ndarray:
+    """(H, W, 3) camera-frame directions through each pixel centre, z = 1 (so a hit's t is its z-depth).
+
+    Example:
+        >>> rays = pixel_rays(UAVCamera(4, 2).K, 4, 2)
+        >>> rays.shape, rays[0, 0, 2], bool(rays[0, 0, 0] < 0 < rays[0, 3, 0])
+        ((2, 4, 3), np.float64(1.0), True)
+    """
+    k = np.asarray(K, dtype=np.float64)
+    u, v = np.meshgrid(np.arange(width), np.arange(height))
+    return np.stack([(u - k[0, 2]) / k[0, 0], (v - k[1, 2]) / k[1, 1], np.ones(u.shape)], -1)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
@@ -11,7 +11,9 @@ from tqdm import tqdm
 
 from render.camera import UAVCamera
 from render.dataset import DatasetWriter, check_output_folder
-from render.renderer import MitsubaRenderer, RenderSettings
+from render.renderer import MitsubaRenderer
+from render.scan import ScanConfig
+from render.settings import RenderSettings
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes.model import Scene
 
@@ -39,3 +41,15 @@ def capture_dataset(scene: Scene, camera: UAVCamera, viewpoints: Sequence[Viewpo
             rgb, depth = renderer.render(c2w, seed=settings.view_seed(i))
             writer.add(rgb, depth, c2w, view)
     return Path(out)
+
+
+def scan_dataset(config: ScanConfig) -> Path:
+    """Render the scan `config` describes (`nbv scan`) and return the dataset folder."""
+    views = config.viewpoints()
+    meta = {"plan": {"name": config.plan, "radius": config.radius, "end_overlap": config.end_overlap,
+                     "side_overlap": config.side_overlap, "views": len(views),
+                     "elevation_deg": config.elevation},
+            "up_axis": config.scene.up_axis}
+    return capture_dataset(config.scene.load(), config.camera, views, config.out,
+                           replace(config.render, seed=config.seed), config.render.variant, meta,
+                           config.overwrite)

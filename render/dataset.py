@@ -1,4 +1,4 @@
-"""View datasets on disk (DESIGN section 6), readable by nerfstudio and Open3D users.
+"""View datasets on disk (docs/data-formats.md), readable by nerfstudio and Open3D users.
 
 A dataset folder holds `transforms.json` (nerfstudio layout: OpenGL
 camera-to-world `transform_matrix`, principal point with pixel centres at +0.5;
@@ -23,6 +23,7 @@ import cv2
 import numpy as np
 from PIL import Image
 
+from common.io import write_json
 from render.camera import UAVCamera
 from render.viewpoint import Viewpoint, opencv_to_opengl, validate_pose
 
@@ -186,13 +187,6 @@ def transforms_json(camera: UAVCamera, frames: list[dict[str, Any]], meta: dict[
         "nbv": {"version": FORMAT_VERSION, "focal_mm": camera.focal_mm, "near_m": camera.near_m,
                 "far_m": camera.far_m, **meta},
     }
-
-
-def write_json(path: Path, doc: Any) -> None:
-    """Write JSON atomically (temporary file, then rename)."""
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    tmp.write_text(json.dumps(doc, indent=2))
-    tmp.replace(path)
 
 
 def check_output_folder(out: Path, overwrite: bool) -> None:

@@ -1,7 +1,7 @@
 """Photoreal RGB-D rendering of a `scenes.Scene` with Mitsuba 3 (the paper's UAV Camera).
 
 The scene is loaded once; each pose gets two cheap sensors and two passes
-(DESIGN section 8): RGB with the configured integrator, spp and a Gaussian
+(docs/rendering.md): RGB with the configured integrator, spp and a Gaussian
 filter; depth with 1 spp, a non-jittered stratified sampler (one ray through
 each pixel centre) and a box filter, so edges never mix foreground and
 background. Depth comes from the `aov` integrator's hit *position*, projected
@@ -14,43 +14,16 @@ an OpenCV camera-to-world maps to it as `c2w @ diag(-1, -1, 1, 1)`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
 
 from render.camera import UAVCamera
+from render.settings import RenderSettings
 from render.variant import select_variant
 from render.viewpoint import validate_pose
 from scenes.model import Material, Part, Scene
 
 OPENCV_TO_MITSUBA = np.diag([-1.0, -1.0, 1.0, 1.0])
-
-
-@dataclass(frozen=True)
-class RenderSettings:
-    """How RGB images are rendered (depth always uses one exact ray per pixel)."""
-
-    spp: int = 16
-    """Samples per pixel of the RGB pass."""
-    max_depth: int = 4
-    """Longest light path (path integrator): 2 = direct light only."""
-    integrator: Literal["path", "direct"] = "path"
-    """Mitsuba integrator of the RGB pass."""
-    seed: int = 0
-    """Base seed; view i of a scan is rendered with seed `seed * 1_000_003 + i`."""
-
-    def __post_init__(self) -> None:
-        if self.spp < 1:
-            raise ValueError(f"render spp must be >= 1, got {self.spp}")
-        if self.max_depth < 1 and self.max_depth != -1:
-            raise ValueError(f"render max_depth must be >= 1 (or -1), got {self.max_depth}")
-        if self.integrator not in ("path", "direct"):
-            raise ValueError(f"render integrator must be 'path' or 'direct', got {self.integrator!r}")
-
-    def view_seed(self, index: int) -> int:
-        """The per-view seed of view `index` (Mitsuba uses seed 0 unless told)."""
-        return (self.seed * 1_000_003 + index) % (2**31)
 
 
 def srgb_to_uint8(linear: np.ndarray) -> np.ndarray:
@@ -72,10 +45,10 @@ class MitsubaRenderer:
 
     def __init__(self, scene: Scene, camera: UAVCamera, settings: RenderSettings | None = None,
                  variant: str | None = None) -> None:
-        self.mi = select_variant(variant)
+        self.settings = settings or RenderSettings()
+        self.mi = select_variant(variant or self.settings.variant)
         self.variant: str = self.mi.variant()
         self.camera = camera
-        self.settings = settings or RenderSettings()
         self.center = scene.center() if scene.parts else np.zeros(3)
         self._scene = self._load_scene(scene)
         self._rgb_integrator = self.mi.load_dict(

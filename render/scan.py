@@ -17,9 +17,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal
 
 from render.camera import UAVCamera
+from render.settings import RenderSettings
 from render.viewpoint import TWO_PI, Viewpoint
+from scenes.spec import SceneSpec
 
 
 @dataclass(frozen=True)
@@ -106,3 +110,40 @@ def circle_scan(camera: UAVCamera, plan: CirclePlan = CirclePlan()) -> list[View
         return ring(plan.radius, elevation, plan.views)
     count = math.ceil(TWO_PI / azimuth_step(camera, plan.end_overlap, elevation) - 1e-9)
     return ring(plan.radius, elevation, count)
+
+
+@dataclass(frozen=True, kw_only=True)
+class ScanConfig:
+    """Settings of `nbv scan`: a scene, a camera, how to render, and the scan plan."""
+
+    scene: SceneSpec
+    """The target."""
+    out: Path
+    """Dataset folder to write (atomically)."""
+    camera: UAVCamera = UAVCamera()
+    """The camera."""
+    render: RenderSettings = RenderSettings()
+    """How views are rendered."""
+    plan: Literal["hemisphere", "circle"] = "hemisphere"
+    """Scan plan: full-coverage hemisphere (paper Sec. V-B) or one circle."""
+    radius: float = 2.0
+    """Camera distance from the scene centre, metres."""
+    end_overlap: float = 0.86
+    """Overlap of consecutive images along a ring (hemisphere; circle when --views is not given)."""
+    side_overlap: float = 0.8
+    """Overlap of images on neighbouring rings (hemisphere)."""
+    views: int | None = None
+    """Number of views (circle); default: derived from --end-overlap."""
+    elevation: float = 30.0
+    """Elevation of the circle, degrees (circle)."""
+    seed: int = 0
+    """Base seed of the per-view render seeds."""
+    overwrite: bool = False
+    """Replace an existing non-empty output folder (only once the new scan is complete)."""
+
+    def viewpoints(self) -> list[Viewpoint]:
+        """The viewpoints the plan asks for."""
+        if self.plan == "hemisphere":
+            plan = HemispherePlan(self.radius, self.end_overlap, self.side_overlap)
+            return hemisphere_scan(self.camera, plan)
+        return circle_scan(self.camera, CirclePlan(self.radius, self.elevation, self.views, self.end_overlap))

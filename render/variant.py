@@ -1,4 +1,4 @@
-"""Choosing the Mitsuba variant, once per process (DESIGN section 2).
+"""Choosing the Mitsuba variant, once per process (docs/conventions.md).
 
 `cuda_ad_rgb` where a CUDA GPU is present, else `llvm_ad_rgb` where a suitable
 libLLVM loads, else `scalar_rgb`. `NBV_VARIANT` (or an explicit argument)
@@ -15,9 +15,12 @@ import os
 import re
 from functools import cache
 from types import ModuleType
+from typing import Literal, get_args
 
-VARIANTS = ("scalar_rgb", "llvm_ad_rgb", "cuda_ad_rgb")
-"""Variants the toolkit supports."""
+Variant = Literal["scalar_rgb", "llvm_ad_rgb", "cuda_ad_rgb"]
+"""A Mitsuba variant the toolkit supports."""
+VARIANTS: tuple[str, ...] = get_args(Variant)
+"""Variants the toolkit supports, slowest first."""
 _MIN_LLVM = 16
 _LLVM_GLOBS = ("/usr/lib/*/libLLVM-*.so", "/usr/lib/*/libLLVM.so.*", "/usr/lib/llvm-*/lib/libLLVM*.so*")
 

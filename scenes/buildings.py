@@ -6,7 +6,7 @@ storeys with optional jetties or setbacks, plinth, string courses, timber
 framing, roofs, chimneys, a tower; then window and door openings are cut;
 then fittings are added (glass, mullions, sills, shutters, doors, balconies,
 porch, steps, columns). `build_building` turns it into a normalised `Scene`
-(DESIGN section 2) with a textured ground.
+(docs/conventions.md) with a textured ground.
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 OBJ (with MTL and textures), PLY, GLB / glTF, DAE (pycollada), STL and OFF are
 read with trimesh, one `Part` per textured sub-mesh, keeping each material's
 base colour and texture. A sub-mesh without a texture gets a procedural one
-projected by planar UVs. The result is normalised (DESIGN section 2) after
+projected by planar UVs. The result is normalised (docs/conventions.md) after
 turning `up_axis` to z, and stands on a textured ground. Arrays are checked
 before use: NaN vertices, meshes without faces and out-of-range face indices
 raise a ValueError naming the file and the fault.
@@ -13,14 +13,13 @@ from __future__ import annotations
 
 import hashlib
 import io
-import os
 from pathlib import Path
 
 import numpy as np
 import trimesh
 from PIL import Image
 
-from scenes.cache import cache_dir
+from common.io import atomic_path, cache_dir
 from scenes.model import Material, Part, Scene, validate_arrays
 from scenes.normalise import make_ground, normalise_parts
 from scenes.surface import Finish, make_part, planar_uv
@@ -116,9 +115,8 @@ def _save_texture(image: Image.Image) -> Path:
     path = cache_dir() / "mesh_textures" / f"{hashlib.sha1(data).hexdigest()}.png"
     if not path.exists():
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{path.stem}.{os.getpid()}.png")
-        tmp.write_bytes(data)
-        tmp.replace(path)
+        with atomic_path(path) as tmp:
+            tmp.write_bytes(data)
     return path
 
 

@@ -4,7 +4,7 @@ A `Scene` is a list of textured triangle `Part`s plus `Lighting`. `render/`
 turns it into a Mitsuba scene; `nbv/` takes the target mesh (the parts marked
 `target`, i.e. everything but the ground) for metrics. Units are metres, the
 world is right-handed with z up, and a normalised target stands on z = 0,
-centred on the z axis, its largest side 1 m (DESIGN section 2).
+centred on the z axis, its largest side 1 m (docs/conventions.md).
 """
 
 from __future__ import annotations

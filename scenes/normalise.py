@@ -1,4 +1,4 @@
-"""Normalising a target (DESIGN section 2) and the ground it stands on.
+"""Normalising a target (docs/conventions.md) and the ground it stands on.
 
 A normalised scene is z-up, its target's bounding box is centred on the z axis,
 its base lies on z = 0 and its largest side measures 1 m. Parts that are not
@@ -12,11 +12,9 @@ from dataclasses import replace
 import numpy as np
 
 from scenes.model import Part
+from scenes.spec import UP_AXES
 from scenes.surface import Finish, make_part
 from scenes.textures import TEXTURES
-
-UP_AXES = ("z", "y")
-"""Up axes a mesh file may use; 'y' (glTF, many DCC exports) is turned to z up."""
 
 
 def up_to_z(vertices: np.ndarray, up_axis: str) -> np.ndarray:

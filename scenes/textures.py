@@ -9,7 +9,6 @@ metres, before a building is normalised) that one tile of it covers.
 
 from __future__ import annotations
 
-import os
 import zlib
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -18,7 +17,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from scenes.cache import cache_dir
+from common.io import atomic_path, cache_dir
 from scenes.noise import anisotropic_fbm, fbm, per_cell, to_uint8, voronoi
 
 TEXTURE_SIZE = 1024
@@ -300,7 +299,6 @@ def texture_path(name: str, seed: int, size: int = TEXTURE_SIZE) -> Path:
     if not path.exists():
         image = make_texture(name, seed, size)
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{path.stem}.{os.getpid()}.png")
-        Image.fromarray(image).save(tmp)
-        tmp.replace(path)
+        with atomic_path(path) as tmp:
+            Image.fromarray(image).save(tmp)
     return path

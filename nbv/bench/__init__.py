@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 AREAS = (
+    "cli",
     "render",
     "scenes",
     "bov",
@@ -23,7 +24,7 @@ class BenchResult:
     """One measured figure."""
 
     area: str
-    """The bench module that measured it (render, scenes, bov, recon, rl)."""
+    """The bench module that measured it (cli, render, scenes, bov, recon, rl)."""
     name: str
     """What was measured, with its settings (e.g. 'RGB-D views/s llvm_ad_rgb 320x240 steady')."""
     value: float

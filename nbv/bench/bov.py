@@ -21,12 +21,14 @@ import numpy as np
 import torch
 
 from nbv.bench import BenchResult
-from nbv.bov import BagOfViews
-from nbv.features import FeatureConfig, extract_features
-from nbv.refine import RefineConfig, refine_dataset
+from nbv.bov.bag import BagOfViews
+from nbv.bov.config import BoVConfig
+from nbv.bov.refine import RefineConfig, refine_dataset
+from nbv.features.sift import FeatureConfig, extract_features
 from render.camera import UAVCamera
 from render.dataset import DatasetWriter
-from render.renderer import MitsubaRenderer, RenderSettings
+from render.renderer import MitsubaRenderer
+from render.settings import RenderSettings
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes import DEFAULT_SCENE, load_scene
 
@@ -114,8 +116,9 @@ def bench_refine(images: np.ndarray, center: np.ndarray) -> list[BenchResult]:
                 writer.add(images[i % len(images)], np.ones((height, width), np.float32),
                            viewpoint_to_c2w(view, center), view)
         start = time.perf_counter()
-        summary = refine_dataset(source, Path(tmp) / "out", RefineConfig(ranges=9, words=20,
-                                                                        cache_dir=Path(tmp) / "cache"))
+        config = RefineConfig(dataset=source, out=Path(tmp) / "out", bov=BoVConfig(ranges=9, words=20),
+                              cache_dir=Path(tmp) / "cache")
+        summary = refine_dataset(config)
         seconds = time.perf_counter() - start
     return [BenchResult("bov", f"refine {REFINE_VIEWS} views {width}x{height} end to end (features, Alg. 1, "
                                f"write; N=9 W=20, kept {summary['kept_views']})", seconds, "s")]

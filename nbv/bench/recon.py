@@ -1,7 +1,7 @@
 """Reconstruction bench: TSDF fusion ms per view and metric seconds.
 
 Views are ray-cast (exact z-depth of the test building and its ground along
-the 288-view hemisphere scan, `nbv.raycast`), so the figures do not depend on
+the 288-view hemisphere scan, `render.raycast`), so the figures do not depend on
 the renderer; only fusion is timed. Side by side, a dense NumPy TSDF in the
 style of the View Planning Toolbox's fusion (3DMatch tsdf-fusion's CPU path:
 every voxel of a box around the target projected into every view) runs on the
@@ -18,10 +18,11 @@ import numpy as np
 import trimesh
 
 from nbv.bench import BenchResult
-from nbv.metrics import MetricsConfig, evaluate_surfaces
-from nbv.raycast import DepthRaycaster
-from nbv.recon import ReconstructionConfig, TSDFFusion
+from nbv.recon.config import MetricsConfig, ReconstructionConfig
+from nbv.recon.metrics import evaluate_surfaces
+from nbv.recon.tsdf import TSDFFusion
 from render.camera import UAVCamera
+from render.raycast import DepthRaycaster
 from render.scan import hemisphere_scan
 from render.viewpoint import viewpoint_to_c2w
 from scenes import load_scene

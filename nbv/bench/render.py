@@ -6,7 +6,8 @@ import time
 
 from nbv.bench import BenchResult
 from render.camera import UAVCamera
-from render.renderer import MitsubaRenderer, RenderSettings
+from render.renderer import MitsubaRenderer
+from render.settings import RenderSettings
 from render.variant import available_variants
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes import DEFAULT_SCENE, load_scene

@@ -9,19 +9,20 @@ the paper measured 0.893 s per step on an RTX 3060.
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import torch
 from tensordict import TensorDict
 from torchrl.envs.utils import ExplorationType, set_exploration_type
 
-from nbv.agent import NetworkConfig
 from nbv.bench import BenchResult
-from nbv.bov import BagOfViews
-from nbv.env import EnvConfig, NBVEnv, gray_frame
-from nbv.features import FeatureConfig, extract_features
-from nbv.train_builders import OptimConfig, make_environment, make_loss_module, make_sac_agent
+from nbv.features.sift import extract_features
+from nbv.rl.builders import make_environment, make_loss_module, make_sac_agent
+from nbv.rl.config import EnvConfig, NetworkConfig, OptimConfig
+from nbv.rl.env import NBVEnv, gray_frame
 from render.viewpoint import Viewpoint
 from scenes import DEFAULT_SCENE
+from scenes.spec import SceneSet
 
 GOAL_PLANNING_MS = 50.0
 
@@ -70,8 +71,8 @@ def planning_ms(config: EnvConfig, repeats: int) -> dict[str, float]:
     td = env.reset()
     images = [env.render_view(Viewpoint(2.0, 0.7 * i, 0.4)) for i in range(repeats)]
     actor, _ = make_sac_agent(config, NetworkConfig())
-    features = FeatureConfig(backend=config.feature_backend, max_features=config.max_features)
-    bov = BagOfViews(config.bov_ranges, config.bov_words, memory_cap=config.bov_memory)
+    features = config.bov.feature_config()
+    bov = config.bov.bag()
     with torch.no_grad(), set_exploration_type(ExplorationType.DETERMINISTIC):
         actor(td.clone())  # warm-up
     extract_features([images[0]], features)
@@ -96,13 +97,13 @@ def planning_ms(config: EnvConfig, repeats: int) -> dict[str, float]:
 def run(quick: bool) -> list[BenchResult]:
     """Env steps/s (1 and 2 workers, 320x240), SAC updates/s, planning ms/step (1 torch thread)."""
     torch.set_num_threads(1)
-    config = EnvConfig(scene=(DEFAULT_SCENE,))
+    config = EnvConfig(scenes=SceneSet(scene=(DEFAULT_SCENE,)))
     steps = 4 if quick else 20
     results = []
     updates = sac_updates_per_s(config, 5 if quick else 50)
     results.append(BenchResult("rl", "SAC updates/s, batch 8, 64x64 frames", updates, "updates/s"))
     for backend in ("kornia", "opencv"):
-        stages = planning_ms(EnvConfig(scene=(DEFAULT_SCENE,), feature_backend=backend), 3 if quick else 12)
+        stages = planning_ms(replace(config, bov=replace(config.bov, features=backend)), 3 if quick else 12)
         for stage, ms in stages.items():
             results.append(BenchResult("rl", f"planning {stage} ms/step ({backend} SIFT)", ms, "ms"))
         total = sum(stages.values())

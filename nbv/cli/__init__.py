@@ -1,49 +1,73 @@
-"""The `nbv` command: one entry point, one module per sub-command.
+"""The `nbv` command: one entry point, one thin module per sub-command.
 
-Each module in `COMMANDS` exposes `register(subparsers)`, which adds its parser
-and sets `func(args) -> int` as the handler.
+`nbv --help` lists the commands without importing any of them, so it starts at
+once; `nbv COMMAND ...` imports only that command's module, whose `main`
+parses its config with tyro (`nbv.cli.parse`) and calls the library.
 """
 
 from __future__ import annotations
 
-import argparse
 import importlib
 import sys
-
-COMMANDS = (
-    "scene",
-    "scan",
-    "refine",
-    "refine_sweep",
-    "reconstruct",
-    "evaluate",
-    "train",
-    "plan",
-    "demo",
-    "tables",
-    "bench",
-)
-"""Sub-command modules under `nbv.cli`, in `--help` order."""
+from typing import NamedTuple
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The top-level parser with every sub-command registered."""
-    parser = argparse.ArgumentParser(
-        prog="nbv", description="Appearance-based next-best-view planning toolkit (Bag of Views).")
-    subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for name in COMMANDS:
-        importlib.import_module(f"nbv.cli.{name}").register(subparsers)
-    return parser
+class Command(NamedTuple):
+    """A sub-command: the module under `nbv.cli` that runs it and its one-line help."""
+
+    module: str
+    help: str
+
+
+COMMANDS = {
+    "scene": Command("scene", "list built-in scenes, export a target mesh, render a gallery"),
+    "scan": Command("scan", "render a hemisphere or circle scan into a view dataset"),
+    "refine": Command("refine", "keep the views a Bag of Views finds new (paper Alg. 1)"),
+    "refine-sweep": Command("refine_sweep", "kept-view counts over a grid of N and W (paper Table 2)"),
+    "reconstruct": Command("reconstruct", "TSDF-fuse a view dataset into a mesh and a point cloud"),
+    "evaluate": Command("evaluate", "Chamfer, Hausdorff, coverage and F-score, with a heat map"),
+    "train": Command("train", "train the SAC next-best-view policy (resumes a run folder)"),
+    "plan": Command("plan", "plan a scan with a planner, reconstruct it and score it"),
+    "compare": Command("compare", "compare planners over seeds on one scene (table and bar chart)"),
+    "plot-training": Command("plot_training", "overlay the learning curves of training runs"),
+    "demo": Command("demo", "scan, refine, reconstruct and evaluate a built-in scene"),
+    "tables": Command("tables", "reproduce the paper's Table 2 and Fig. 6"),
+    "bench": Command("bench", "measure throughput figures (make bench)"),
+}
+"""Sub-command name -> where it lives, in `--help` order."""
+
+ERRORS = (ValueError, FileExistsError, FileNotFoundError, PermissionError)
+"""Exceptions that are the user's input at fault: reported in one line, exit status 2."""
+
+
+def usage() -> str:
+    """The top-level help: every command with its one-line description."""
+    width = max(map(len, COMMANDS))
+    lines = ["usage: nbv COMMAND [OPTIONS]", "",
+             "Appearance-based next-best-view planning toolkit (Bag of Views).", "", "commands:"]
+    lines += [f"  {name:<{width}}  {command.help}" for name, command in COMMANDS.items()]
+    lines += ["", "`nbv COMMAND --help` lists a command's options."]
+    return "\n".join(lines)
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run the `nbv` command line; bad input exits with status 2 and a one-line message."""
-    args = build_parser().parse_args(argv)
-    try:
-        return int(args.func(args) or 0)
-    except (ValueError, FileExistsError, FileNotFoundError, PermissionError) as err:
-        print(f"nbv {args.command}: error: {err}", file=sys.stderr)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if not argv or argv[0] in ("-h", "--help"):
+        print(usage(), file=sys.stdout if argv else sys.stderr)
+        return 0 if argv else 2
+    name, rest = argv[0], argv[1:]
+    if name not in COMMANDS:
+        print(f"nbv: error: unknown command {name!r} (choose from {', '.join(COMMANDS)})", file=sys.stderr)
         return 2
+    module = importlib.import_module(f"nbv.cli.{COMMANDS[name].module}")
+    try:
+        return int(module.main(rest, prog=f"nbv {name}") or 0)
+    except ERRORS as err:
+        print(f"nbv {name}: error: {err}", file=sys.stderr)
+        return 2
+    except SystemExit as done:  # tyro's --help (0) and its messages about bad options (2)
+        return 0 if done.code is None else done.code if isinstance(done.code, int) else 2
 
 
 if __name__ == "__main__":

@@ -1,49 +1,51 @@
-"""`nbv scene list`, `nbv scene export SCENE --out DIR` and `nbv scene gallery --out FILE.png`."""
+"""`nbv scene list`, `nbv scene export SCENE --out DIR` and `nbv scene gallery --out FILE.png`.
+
+`list` imports only the scene names (no mesh, texture or render code), so it starts at once.
+"""
 
 from __future__ import annotations
 
-import argparse
-import os
-from pathlib import Path
+import sys
+from collections.abc import Sequence
 
-from nbv.cli.config_args import add_config_arguments, config_from_args
-from scenes import list_scenes, load_scene
-from scenes.normalise import UP_AXES
-
-
-def export_scene(name: str, out: Path, up_axis: str = "z") -> Path:
-    """Write the normalised target mesh (exactly as rendered, no ground) to `out/mesh.ply`."""
-    mesh = load_scene(name, up_axis).target_mesh()
-    out.mkdir(parents=True, exist_ok=True)
-    path = out / "mesh.ply"
-    tmp = out / f".mesh.ply.tmp-{os.getpid()}"
-    mesh.export(tmp, file_type="ply")
-    tmp.replace(path)
-    return path
+ACTIONS = {
+    "list": "print the built-in scene names",
+    "export": "write OUT/mesh.ply, the normalised target mesh (as rendered, no ground)",
+    "gallery": "render each scene from four sides onto one PNG sheet",
+}
+"""The actions of `nbv scene` and their one-line help."""
 
 
-def _gallery(args: argparse.Namespace) -> None:
-    from nbv.gallery import GalleryConfig, render_gallery
+def usage(prog: str) -> str:
+    """The help of `nbv scene`: its actions."""
+    lines = [f"usage: {prog} {{{','.join(ACTIONS)}}} [OPTIONS]", "", "actions:"]
+    lines += [f"  {name:<8} {text}" for name, text in ACTIONS.items()]
+    lines += ["", f"`{prog} ACTION --help` lists an action's options."]
+    return "\n".join(lines)
 
-    print(render_gallery(config_from_args(GalleryConfig, args)))
 
+def main(args: Sequence[str], prog: str) -> int:
+    """Dispatch on the action (the first argument) and run it."""
+    args = list(args)
+    if not args or args[0] in ("-h", "--help"):
+        print(usage(prog), file=sys.stdout if args else sys.stderr)
+        return 0 if args else 2
+    action, rest = args[0], args[1:]
+    if action == "list":
+        from scenes.catalog import list_scenes
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Add the `scene` sub-command with its `list`, `export` and `gallery` actions."""
-    from nbv.gallery import GalleryConfig
+        print("\n".join(list_scenes()))
+        return 0
+    if action == "export":
+        from nbv.cli.parse import parse
+        from scenes.catalog import ExportConfig, export_scene
 
-    p = subparsers.add_parser("scene", help="list built-in scenes, export a target mesh, render a gallery")
-    actions = p.add_subparsers(dest="action", required=True, metavar="ACTION")
-    actions.add_parser("list", help="print the built-in scene names").set_defaults(
-        func=lambda args: print("\n".join(list_scenes()))
-    )
-    export = actions.add_parser("export", help="write OUT/mesh.ply, the normalised target mesh")
-    export.add_argument(
-        "scene", metavar="SCENE", help="built-in scene name, random:SEED, or a mesh / Mitsuba XML file path"
-    )
-    export.add_argument("--out", type=Path, required=True, help="output folder")
-    export.add_argument("--up-axis", choices=UP_AXES, default="z", help="up axis of a mesh file (default: z)")
-    export.set_defaults(func=lambda args: print(export_scene(args.scene, args.out, args.up_axis)))
-    gallery = actions.add_parser("gallery", help="render each scene from four sides onto one PNG sheet")
-    add_config_arguments(gallery, GalleryConfig)
-    gallery.set_defaults(func=_gallery)
+        print(export_scene(parse(ExportConfig, rest, f"{prog} export")))
+        return 0
+    if action == "gallery":
+        from nbv.cli.parse import parse
+        from render.gallery import GalleryConfig, render_gallery
+
+        print(render_gallery(parse(GalleryConfig, rest, f"{prog} gallery")))
+        return 0
+    raise ValueError(f"unknown action {action!r} (choose from {', '.join(ACTIONS)})")

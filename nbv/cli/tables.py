@@ -1,23 +1,21 @@
-"""`nbv tables`: reproduce the paper's Table 2 (what `make tables` runs)."""
+"""`nbv tables`: reproduce the paper's Table 2 and Fig. 6 (what `make tables` runs)."""
 
 from __future__ import annotations
 
-import argparse
+from collections.abc import Sequence
+from pathlib import Path
 
-from nbv.cli.config_args import add_config_arguments, config_from_args
-from nbv.tables import TablesConfig, run_tables
+from tqdm import tqdm
 
-
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Add the `tables` sub-command."""
-    p = subparsers.add_parser("tables", help="reproduce the paper's Table 2 beside its numbers")
-    add_config_arguments(p, TablesConfig)
-    p.set_defaults(func=tables)
+from nbv.cli.parse import parse
+from nbv.experiments.table2 import TablesConfig, run_tables
 
 
-def tables(args: argparse.Namespace) -> int:
-    """Run the tables and print the Markdown."""
-    config = config_from_args(TablesConfig, args)
-    run_tables(config)
-    print((config.out / "table2.md").read_text())
+def main(args: Sequence[str], prog: str) -> int:
+    """Parse `TablesConfig`, measure every building, print the Markdown table."""
+    config = parse(TablesConfig, args, prog)
+    rows = len(config.scenes) * (1 + len(config.ranges) * len(config.words))
+    with tqdm(total=rows, desc="table 2 rows", unit="row") as bar:
+        run_tables(config, bar.update)
+    print((Path(config.out) / "table2.md").read_text())
     return 0

@@ -12,8 +12,9 @@ from nbv.cli import main
 from render.camera import UAVCamera
 from render.capture import capture_dataset
 from render.dataset import DatasetError, DatasetWriter, read_dataset, write_subset
-from render.renderer import MitsubaRenderer, RenderSettings
+from render.renderer import MitsubaRenderer
 from render.scan import CirclePlan, HemispherePlan, circle_scan, hemisphere_scan
+from render.settings import RenderSettings
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes import load_scene
 

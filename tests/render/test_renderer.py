@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from render.camera import UAVCamera
-from render.renderer import MitsubaRenderer, RenderSettings, srgb_to_uint8
+from render.renderer import MitsubaRenderer, srgb_to_uint8
+from render.settings import RenderSettings
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes import load_scene
 from scenes.model import Lighting, Material, Part, Scene

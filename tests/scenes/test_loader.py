@@ -10,7 +10,8 @@ import trimesh
 from PIL import Image
 
 from render.camera import UAVCamera
-from render.renderer import MitsubaRenderer, RenderSettings
+from render.renderer import MitsubaRenderer
+from render.settings import RenderSettings
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes import load_scene
 

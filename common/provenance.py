@@ -1,0 +1,68 @@
+"""Where a result came from: the commit that produced it, and its config as a record and back."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import subprocess
+import types
+import typing
+from pathlib import Path
+from typing import Any, TypeVar
+
+T = TypeVar("T")
+
+
+def _git(*args: str) -> str:
+    return subprocess.run(["git", *args], capture_output=True, text=True, check=True).stdout.strip()
+
+
+def config_record(config: Any) -> dict:
+    """A config dataclass as JSON-compatible nested dicts (tuples as lists, paths as strings)."""
+    return json.loads(json.dumps(dataclasses.asdict(config), default=str))
+
+
+def config_from_record(cls: type[T], record: dict) -> T:
+    """The config dataclass `cls` rebuilt from `config_record`'s output (the inverse, nested included).
+
+    Keys the record lacks take the field's default; unknown keys are an error naming them.
+
+    Example:
+        >>> Run = dataclasses.make_dataclass("Run", [("sizes", tuple[int, ...]), ("out", Path | None)])
+        >>> config_from_record(Run, {"sizes": [2, 3], "out": "run"})
+        Run(sizes=(2, 3), out=PosixPath('run'))
+    """
+    if not isinstance(record, dict):
+        raise ValueError(f"a {cls.__name__} record must be a JSON object, got {type(record).__name__}")
+    hints = typing.get_type_hints(cls, include_extras=False)
+    fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
+    unknown = sorted(set(record) - set(fields))
+    if unknown:
+        raise ValueError(f"{cls.__name__} has no field(s) {', '.join(unknown)}")
+    return cls(**{name: _value(hints[name], value) for name, value in record.items()})
+
+
+def _value(tp: Any, value: Any) -> Any:
+    if value is None:
+        return None
+    if typing.get_origin(tp) in (typing.Union, types.UnionType):
+        options = [a for a in typing.get_args(tp) if a is not type(None)]
+        tp = options[0] if len(options) == 1 else Any
+    if dataclasses.is_dataclass(tp):
+        return config_from_record(tp, value)
+    if typing.get_origin(tp) is tuple and isinstance(value, list):
+        args = typing.get_args(tp)
+        item = args[0] if args else Any
+        return tuple(_value(item, v) for v in value)
+    if tp is Path:
+        return Path(value)
+    return value
+
+
+def git_commit() -> str:
+    """Short hash of the checked-out commit (with '+dirty' for uncommitted changes), or 'unknown'."""
+    try:
+        dirty = "+dirty" if _git("status", "--porcelain", "-uno") else ""
+        return _git("rev-parse", "--short", "HEAD") + dirty
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"

@@ -1,0 +1,183 @@
+"""Offline dataset refinement with the Bag of Views (paper Alg. 1, Sec. VI-B, Table 2).
+
+Walk a view dataset in its order; keep a view iff its BoV score is > 0, and
+let only kept views update the vocabularies (docs/bov.md §5). The azimuth of
+a frame is its recorded viewpoint's, else the one computed from its pose about
+the dataset's centre. Features come from the on-disk cache, so a sweep over
+(N, W) extracts them once (`nbv.bov.sweep`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+import torch
+from tyro.conf import Positional, arg
+
+from common.io import write_json
+from common.provenance import config_record
+from nbv.bov.bag import DEFAULT_MATCH_COSINE, BagOfViews
+from nbv.bov.config import BoVConfig, BoVRule
+from nbv.features.cache import dataset_features
+from nbv.features.sift import Features
+from render.dataset import ViewDataset, check_output_folder, read_dataset, write_subset
+from render.viewpoint import c2w_to_viewpoint
+
+Progress = Callable[[int], None]
+"""Called with a count of work just done (e.g. a tqdm bar's `update`)."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class DatasetRun:
+    """A run over a view dataset's features: what `nbv refine` and `nbv refine-sweep` share."""
+
+    dataset: Annotated[Path, Positional, arg(metavar="DATASET")]
+    """A view dataset folder (transforms.json, images/, depth/), e.g. from `nbv scan`."""
+    seed: int = 0
+    """Seed of the reservoir and k-means++ draws."""
+    device: str = "cpu"
+    """Torch device of features and Bag of Views."""
+    threads: int = 0
+    """Torch CPU threads (0: torch's default, one per core); 1 on cores shared with other jobs
+    (docs/conventions.md §9)."""
+    cache_dir: Path | None = None
+    """Feature cache folder (default: $NBV_CACHE_DIR/features or ~/.cache/nbv/features)."""
+
+    def settings(self, rule: BoVRule) -> dict[str, Any]:
+        """The rule and this run's settings as one flat record (`settings` in refine.json, sweep.json)."""
+        return {**config_record(rule), "seed": self.seed, "device": self.device,
+                "cache_dir": None if self.cache_dir is None else str(self.cache_dir), "threads": self.threads}
+
+
+@dataclass(frozen=True, kw_only=True)
+class RefineConfig(DatasetRun):
+    """Settings of `nbv refine`: a dataset, a Bag of Views of N ranges x W words, an output folder."""
+
+    out: Path
+    """Folder for the refined dataset and refine.json."""
+    bov: BoVConfig = BoVConfig()
+    """The Bag of Views: N, W and the rule."""
+    overwrite: bool = False
+    """Replace the output folder if it is not empty."""
+
+
+@dataclass(frozen=True)
+class RefineResult:
+    """The outcome of Alg. 1 over a sequence of views."""
+
+    kept: list[int]
+    """Indices of the kept views, in order."""
+    scores: list[float]
+    """Each view's score when it was reached (+inf: first view of its range)."""
+    ranges: list[int]
+    """Each view's azimuth range."""
+
+
+def frame_azimuths(dataset: ViewDataset) -> np.ndarray:
+    """Azimuth of every frame: its recorded viewpoint, else computed from its pose about the centre."""
+    return np.array([f.viewpoint.azimuth if f.viewpoint is not None
+                     else c2w_to_viewpoint(f.c2w, dataset.center).azimuth for f in dataset.frames])
+
+
+def refine_views(descriptors: Sequence[torch.Tensor], azimuths: Sequence[float], ranges: int,
+                 words: int, memory_cap: int = 2048, seed: int = 0,
+                 device: str | torch.device | None = None,
+                 match_cosine: float = DEFAULT_MATCH_COSINE, kmeans_iters: int = 10) -> RefineResult:
+    """Paper Alg. 1 over views in order: keep iff score > 0, update only with kept views.
+
+    Args:
+        descriptors: per view, its (M, D) descriptors.
+        azimuths: per view, its azimuth in radians.
+        ranges: N.
+        words: W.
+        memory_cap: descriptors held per range.
+        seed: seed of the Bag of Views.
+        device: torch device of the Bag of Views.
+        match_cosine: c of the dissimilarity d = 1 - cos / c.
+        kmeans_iters: most Lloyd rounds of one vocabulary update.
+
+    Example:
+        >>> e = torch.eye(4)
+        >>> refine_views([e[:2], e[:1], e[:0], e[2:3], e[3:4]], [0.5, 1.0, 4.0, 2.0, 3.5], 2, 1,
+        ...              match_cosine=0.5).kept
+        [0, 3, 4]
+    """
+    if len(descriptors) != len(azimuths):
+        raise ValueError(f"{len(descriptors)} views but {len(azimuths)} azimuths")
+    dim = descriptors[0].shape[-1] if len(descriptors) else 128
+    bov = BagOfViews(ranges, words, memory_cap=memory_cap, seed=seed, device=device, dim=dim,
+                     kmeans_iters=kmeans_iters, match_cosine=match_cosine)
+    kept, scores = [], []
+    for i, (desc, azimuth) in enumerate(zip(descriptors, azimuths)):
+        score = bov.score(desc, float(azimuth))  # Alg. 1 lines 6-9
+        scores.append(score)
+        if score > 0:  # Alg. 1 line 10: a non-zero positive score keeps the view
+            bov.update(desc, float(azimuth))  # lines 11-12
+            kept.append(i)
+    return RefineResult(kept, scores, [bov.range_of(float(a)) for a in azimuths])
+
+
+def refine_with(rule: BoVRule, descriptors: Sequence[torch.Tensor], azimuths: Sequence[float], ranges: int,
+                words: int, seed: int = 0, device: str | torch.device | None = None) -> RefineResult:
+    """`refine_views` with a Bag of Views of N = `ranges`, W = `words` under `rule`."""
+    return refine_views(descriptors, azimuths, ranges, words, rule.memory_cap, seed, device,
+                        rule.match_cosine, rule.kmeans_iters)
+
+
+def load_views(run: DatasetRun, rule: BoVRule, progress: Progress | None = None
+               ) -> tuple[ViewDataset, list[Features], np.ndarray]:
+    """Read the run's dataset and its (cached) features and azimuths; fail clearly on an empty dataset."""
+    dataset = read_dataset(run.dataset)
+    if run.threads > 0:
+        torch.set_num_threads(run.threads)
+    feats = dataset_features(dataset, rule.feature_config(run.device), run.cache_dir, progress)
+    return dataset, feats, frame_azimuths(dataset)
+
+
+def _json_score(score: float) -> float | None:
+    return None if math.isinf(score) else round(score, 6)
+
+
+def refine_dataset(config: RefineConfig, progress: Progress | None = None) -> dict[str, Any]:
+    """Refine `config.dataset` into `config.out`: the kept views as a dataset, plus `refine.json`.
+
+    `progress` is called with the number of views whose features were just extracted.
+    Returns the summary written to `refine.json` (docs/data-formats.md §6): `kept` (source
+    frame indices), `scores` (null for +inf), `ranges` (each source frame's range), settings, timing.
+    """
+    out = Path(config.out)
+    check_output_folder(out, config.overwrite)  # fail before the work, not after
+    start = time.perf_counter()
+    dataset, feats, azimuths = load_views(config, config.bov, progress)
+    result = refine_with(config.bov, [f.descriptors for f in feats], azimuths, config.bov.ranges,
+                         config.bov.words, config.seed, config.device)
+    settings = config.settings(config.bov)
+    summary = {"dataset": str(config.dataset), "source_views": len(dataset), "kept_views": len(result.kept),
+               "kept": result.kept, "scores": [_json_score(s) for s in result.scores],
+               "ranges": result.ranges, "settings": settings,
+               "seconds": round(time.perf_counter() - start, 3),
+               "note": "scores: null is +inf (first view of an empty range); a view is kept iff score > 0"}
+    write_subset(dataset, result.kept, out, {"refine": {"source": str(config.dataset), **settings}},
+                 config.overwrite)
+    write_json(out / "refine.json", summary)
+    return summary
+
+
+def kept_view_grid(descriptors: Sequence[torch.Tensor], azimuths: Sequence[float], ranges: Sequence[int],
+                   words: Sequence[int], rule: BoVRule = BoVRule(), seed: int = 0,
+                   device: str | torch.device | None = None,
+                   progress: Progress | None = None) -> dict[tuple[int, int], RefineResult]:
+    """Alg. 1 for every (N, W) of the grid over the same features (paper Table 2): {(N, W): result}."""
+    grid = {}
+    for n in ranges:
+        for w in words:
+            grid[(n, w)] = refine_with(rule, descriptors, azimuths, n, w, seed, device)
+            if progress is not None:
+                progress(1)
+    return grid

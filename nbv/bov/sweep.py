@@ -1,0 +1,98 @@
+"""Kept-view counts over a grid of Bag of Views sizes (paper Table 2's N x W grid), from one feature pass.
+
+`sweep` reads a dataset's features once (cached), runs Alg. 1 for every
+(N, W) and writes `sweep.csv` (one row per cell), `sweep.md` (Table 2's
+layout: one column per cell) and `sweep.json` (rows, kept indices, settings).
+"""
+
+from __future__ import annotations
+
+import csv
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from common.io import atomic_path, markdown_table, write_json, write_text
+from nbv.bov.config import BoVRule
+from nbv.bov.refine import DatasetRun, Progress, RefineResult, kept_view_grid, load_views
+
+PAPER_RANGES = (5, 7, 9, 11)
+"""The N values of the paper's Table 2."""
+PAPER_WORDS = (10, 20, 30)
+"""The W values of the paper's Table 2."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class SweepConfig(DatasetRun):
+    """Settings of `nbv refine-sweep`: a dataset, the grid of N and W, the rule shared by every cell."""
+
+    out: Path
+    """Folder for sweep.csv, sweep.md and sweep.json."""
+    ranges: tuple[int, ...] = PAPER_RANGES
+    """Values of N (azimuth ranges), the columns' first key (paper Table 2: 5 7 9 11)."""
+    words: tuple[int, ...] = PAPER_WORDS
+    """Values of W (words per range), the columns' second key (paper Table 2: 10 20 30)."""
+    rule: BoVRule = BoVRule()
+    """The Bag of Views rule and features of every cell."""
+
+    def __post_init__(self) -> None:
+        for name in ("ranges", "words"):
+            values = getattr(self, name)
+            if not values or any(v < 1 for v in values):
+                raise ValueError(f"--{name} values must be >= 1 (at least one), got {values}")
+
+
+def sweep(config: SweepConfig, progress: Progress | None = None,
+          grid_progress: Progress | None = None) -> dict[str, Any]:
+    """Run the grid and write sweep.csv, sweep.md and sweep.json into `config.out`; return the JSON.
+
+    `progress` is called per view whose features were just extracted, `grid_progress` per cell done.
+    """
+    start = time.perf_counter()
+    dataset, feats, azimuths = load_views(config, config.rule, progress)
+    grid = kept_view_grid([f.descriptors for f in feats], azimuths, config.ranges, config.words,
+                          config.rule, config.seed, config.device, grid_progress)
+    rows = grid_rows(grid, len(dataset))
+    out = Path(config.out)
+    out.mkdir(parents=True, exist_ok=True)
+    write_csv(out / "sweep.csv", rows)
+    write_text(out / "sweep.md", sweep_markdown(rows, str(config.dataset)))
+    doc = {"dataset": str(config.dataset), "source_views": len(dataset), "grid": rows,
+           "kept": {f"{n},{w}": r.kept for (n, w), r in grid.items()},
+           "settings": config.settings(config.rule),
+           "seconds": round(time.perf_counter() - start, 3)}
+    write_json(out / "sweep.json", doc)
+    return doc
+
+
+def grid_rows(grid: dict[tuple[int, int], RefineResult], source_views: int) -> list[dict[str, int]]:
+    """One row per (N, W): `ranges`, `words`, `kept_views`, `source_views`."""
+    return [{"ranges": n, "words": w, "kept_views": len(r.kept), "source_views": source_views}
+            for (n, w), r in grid.items()]
+
+
+def write_csv(path: Path, rows: list[dict[str, Any]], fieldnames: list[str] | None = None) -> Path:
+    """Write dict rows as CSV, atomically; columns: `fieldnames` (default: the first row's keys).
+
+    A row lacking a column leaves its cell blank.
+    """
+    with atomic_path(path) as tmp, open(tmp, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=fieldnames or list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    return path
+
+
+def sweep_markdown(rows: list[dict[str, int]], name: str) -> str:
+    """Table 2's layout: one column per (N, W), one row of kept-view counts."""
+    header = ["", *(f"N={r['ranges']} W={r['words']}" for r in rows)]
+    counts = [f"kept views of {rows[0]['source_views']}", *(r["kept_views"] for r in rows)]
+    return f"# Bag-of-Views refinement of {name}\n\n" + markdown_table(header, [counts])
+
+
+def sweep_summary(doc: dict[str, Any]) -> str:
+    """The grid of a sweep.json document as plain text lines (N W kept)."""
+    lines = [f"{doc['source_views']} source views; kept per (N, W):"]
+    lines += [f"  N={r['ranges']:>2} W={r['words']:>2}: {r['kept_views']}" for r in doc["grid"]]
+    return "\n".join(lines)

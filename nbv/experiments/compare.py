@@ -1,0 +1,104 @@
+"""`nbv compare`: planners over seeds on one (held-out) scene, beside the paper's Fig. 1.
+
+Every run is an `nbv plan` run (`nbv.planning.plan.plan_scan`) under the same
+shared settings; the table gives views, coverage, Chamfer and Hausdorff
+distances against the full-scan reference and the ground truth, mean +- std
+over seeds (docs/rl.md §10). Example (paper_results/planners):
+
+    nbv compare alpine_chalet --views 13 --planners policy:runs/policy/checkpoint.pt random circle greedy \\
+        --seeds 0 1 2 --out cmp
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from common.io import write_json
+from common.provenance import config_record, git_commit
+from nbv.experiments.paper_numbers import FIG1_NBV
+from nbv.planning.plan import PlanSettings, plan_scan
+from nbv.planning.planners import planner_label
+from nbv.viz.figures import plot_planner_comparison
+
+
+@dataclass(frozen=True, kw_only=True)
+class CompareConfig(PlanSettings):
+    """Settings of `nbv compare`: every `nbv plan` setting but the planner and seed, which it varies."""
+
+    planners: tuple[str, ...] = ("random", "circle", "greedy")
+    """Planners to compare: policy:CHECKPOINT, policy-sample:CHECKPOINT, random, circle, greedy,
+    hemisphere."""
+    seeds: tuple[int, ...] = (0, 1, 2)
+    """Seeds per planner."""
+    out: Path
+    """Folder of the runs (<planner label>-seed<seed>/, each an `nbv plan` output) and of
+    comparison.{json,md,png}; runs already there are read back, not redone."""
+
+    def __post_init__(self) -> None:
+        if not self.planners or not self.seeds:
+            raise ValueError("a comparison needs at least one planner and one seed")
+
+
+COMPARED = (("coverage", "reference", 100.0, "coverage % (ref)"),
+            ("chamfer_cm", "reference", 1.0, "Chamfer cm (ref)"),
+            ("hausdorff_cm", "reference", 1.0, "Hausdorff cm (ref)"),
+            ("coverage", "gt", 100.0, "coverage % (gt)"),
+            ("chamfer_cm", "gt", 1.0, "Chamfer cm (gt)"),
+            ("hausdorff_cm", "gt", 1.0, "Hausdorff cm (gt)"))
+"""Table columns: (metric, against, display scale, header). The paper's Fig. 1 compares with the full scan
+(`reference`); the same metrics against the ground-truth mesh (`gt`) follow."""
+
+
+def compare_planners(config: CompareConfig) -> str:
+    """Run `plan_scan` for every planner and seed; write comparison.{json,md,png}; return the table.
+
+    Each run goes to `out/<label>-seed<seed>/` (`planner_label`); runs already there are read back.
+    The table gives mean +- std over seeds beside the paper's Fig. 1 (13 views, SAC policy).
+    """
+    out = Path(config.out)
+    runs = []
+    for planner in config.planners:
+        label = planner_label(planner)
+        for seed in config.seeds:
+            folder = out / f"{label}-seed{seed}"
+            if (folder / "plan.json").is_file():
+                doc = json.loads((folder / "plan.json").read_text())
+            else:
+                doc = plan_scan(config.plan_config(planner, seed, folder, overwrite=True))
+            runs.append({"planner": label, "seed": seed, **{k: doc[k] for k in ("views", "gt", "reference")}})
+    scene = config.scene.scene
+    write_json(out / "comparison.json", {
+        "scene": scene, "seeds": list(config.seeds), "planners": list(config.planners),
+        "commit": git_commit(), "config": config_record(config), "runs": runs, "paper_fig1": FIG1_NBV})
+    table = comparison_table(runs, scene, config.metrics.threshold_cm)
+    (out / "comparison.md").write_text(table)
+    plot_planner_comparison(runs, FIG1_NBV, out / "comparison.png",
+                            f"Planners on {Path(scene).name}, {len(config.seeds)} seeds")
+    return table
+
+
+def comparison_table(runs: list[dict], scene: str, threshold_cm: float) -> str:
+    """A Markdown table, one row per planner (mean +- std over its runs), the paper's Fig. 1 last."""
+    header = ["planner", "views", *(label for *_, label in COMPARED)]
+    lines = [f"Planners on {scene}: mean ± std over seeds; coverage within {threshold_cm:g} cm; "
+             "ref = the full 288-view scan's reconstruction, gt = the ground-truth mesh", "",
+             "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for planner in dict.fromkeys(r["planner"] for r in runs):
+        mine = [r for r in runs if r["planner"] == planner]
+        cells = [f"{planner} ({len(mine)} seeds)", _mean_std([r["views"] for r in mine], "{:.1f}")]
+        for metric, against, scale, _ in COMPARED:
+            cells.append(_mean_std([scale * r[against][metric] for r in mine], "{:.2f}"))
+        lines.append("| " + " | ".join(cells) + " |")
+    paper = [f"{scale * FIG1_NBV[metric]:.2f}" if against == "reference" else "-"
+             for metric, against, scale, _ in COMPARED]
+    lines.append("| paper Fig. 1 (SAC policy, vs 288-view scan) | 13 | " + " | ".join(paper) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def _mean_std(values: list[float], fmt: str) -> str:
+    arr = np.asarray(values, dtype=np.float64)
+    return f"{fmt.format(arr.mean())} ± {fmt.format(arr.std())}" if len(arr) > 1 else fmt.format(arr.mean())

@@ -1,0 +1,174 @@
+"""`nbv plan`: plan a scan with one planner, capture it, reconstruct it, score it.
+
+Stages, each a verb: `choose_views` (the planner, on a one-worker env),
+`capture_dataset` (RGB-D views on disk), `reconstruct_dataset` (TSDF fusion),
+`evaluate` (`nbv evaluate`'s function, so `metrics.json` has its format)
+against the ground-truth mesh (`gt`) and against the full-scan reconstruction
+(`reference`, paper Sec. V-B), and the trajectory plot. The reference is
+`--reference MESH` when given; otherwise the hemisphere scan of the same
+scene and camera (`render.scan_cache.full_scan`) is reconstructed once and
+cached beside that scan (docs/rl.md §10, docs/reconstruction.md).
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass, fields, replace
+from pathlib import Path
+
+import numpy as np
+
+from common.io import write_json
+from common.provenance import config_record
+from nbv.bov.config import BoVConfig
+from nbv.planning.planners import Planner, PolicyPlanner, make_planner
+from nbv.recon.config import MetricsConfig, ReconstructionConfig
+from nbv.recon.evaluate import EvaluateConfig, GroundTruth, evaluate
+from nbv.recon.tsdf import reconstruct_dataset, save_reconstruction
+from nbv.rl.config import EnvConfig
+from nbv.rl.env import NBVEnv
+from nbv.viz.figures import plot_trajectory
+from render.camera import UAVCamera
+from render.capture import capture_dataset
+from render.dataset import check_output_folder, read_dataset
+from render.scan import HemispherePlan
+from render.scan_cache import full_scan
+from render.settings import RenderSettings
+from render.viewpoint import Viewpoint, viewpoint_to_c2w
+from scenes.model import Scene
+from scenes.spec import SceneSet, SceneSpec
+
+RECONSTRUCTION_KEY = "reconstruction.json"
+"""The settings a cached reference reconstruction was fused with, beside its mesh."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class PlanSettings:
+    """What every planned scan of one target shares: camera, rendering, Bag of Views, fusion, scoring."""
+
+    scene: SceneSpec
+    """The target."""
+    views: int | None = None
+    """Number of views; default: the policy's episode, the whole hemisphere, or 13 (paper Fig. 1)."""
+    camera: UAVCamera = UAVCamera()
+    """The camera of the captured views (a policy plans at its training resolution)."""
+    render: RenderSettings = RenderSettings()
+    """How views are rendered."""
+    bov: BoVConfig = BoVConfig(ranges=8)
+    """The Bag of Views of the greedy planner's reward (a policy keeps its training one)."""
+    candidates: int = 8
+    """Greedy planner: candidate viewpoints rendered per step."""
+    reference: Path | None = None
+    """Reference mesh (full-scan reconstruction); default: reconstruct the hemisphere scan, cached."""
+    metrics: MetricsConfig = MetricsConfig()
+    """How the reconstruction is scored."""
+    recon: ReconstructionConfig = ReconstructionConfig()
+    """TSDF fusion of the captured views (and of the reference scan)."""
+
+    def plan_config(self, planner: str, seed: int, out: Path, overwrite: bool = False) -> PlanConfig:
+        """The `nbv plan` run of one planner and seed under these settings."""
+        shared = {f.name: getattr(self, f.name) for f in fields(PlanSettings)}
+        return PlanConfig(**shared, planner=planner, seed=seed, out=out, overwrite=overwrite)
+
+
+@dataclass(frozen=True, kw_only=True)
+class PlanConfig(PlanSettings):
+    """Settings of `nbv plan`."""
+
+    planner: str = "random"
+    """random, circle, greedy, hemisphere, policy:CHECKPOINT (a `nbv train` checkpoint.pt, its mode) or
+    policy-sample:CHECKPOINT (seeded draws from the policy)."""
+    out: Path
+    """Output folder: views/, mesh.ply, points.ply, gt.ply, metrics.json, heatmap.*, trajectory.png,
+    plan.json."""
+    seed: int = 0
+    """Seed of the planner, the start view, the renders and the metrics' sampling."""
+    overwrite: bool = False
+    """Replace a non-empty output folder."""
+
+
+def scan_env_config(config: PlanSettings) -> EnvConfig:
+    """The plan's own env: its scene, camera, rendering and Bag of Views, the default viewpoint ranges."""
+    scenes = SceneSet(scene=(config.scene.scene,), up_axis=config.scene.up_axis)
+    return EnvConfig(scenes=scenes, camera=config.camera, render=config.render, bov=config.bov)
+
+
+def planning_env_config(config: PlanConfig, planner: Planner) -> EnvConfig:
+    """The env the planner works in: a policy's training settings on this scene, else `scan_env_config`."""
+    own = scan_env_config(config)
+    if isinstance(planner, PolicyPlanner):
+        trained = planner.env_config
+        render = replace(trained.render, variant=config.render.variant)
+        return replace(trained, scenes=own.scenes, render=render)
+    return own
+
+
+def choose_views(config: PlanConfig, planner: Planner,
+                 env_config: EnvConfig) -> tuple[list[Viewpoint], float]:
+    """The planner's viewpoints and the planning wall time in seconds (renders included)."""
+    env = NBVEnv(env_config, seed=config.seed)
+    start = time.perf_counter()
+    views = planner.plan(env, config.views)
+    return views, time.perf_counter() - start
+
+
+def reference_mesh(config: PlanConfig, scene: Scene | None = None) -> Path:
+    """The full hemisphere scan's reconstruction (paper Sec. V-B), cached inside the cached scan's folder.
+
+    The scan comes from `render.scan_cache.full_scan`, re-rendered only when the scene, camera or
+    settings change (a re-rendered scan replaces its folder, the stale reconstruction with it); the
+    reconstruction is redone when its settings (`RECONSTRUCTION_KEY`) change.
+    """
+    if config.reference is not None:
+        return Path(config.reference)
+    env_config = scan_env_config(config)
+    radius = (env_config.radius_min + env_config.radius_max) / 2.0
+    settings = replace(config.render, seed=config.seed)
+    full = full_scan(scene or config.scene.load(), config.camera, settings=settings,
+                     variant=config.render.variant, plan=HemispherePlan(radius=radius), progress=False)
+    folder = full.root / f"reconstruction_{config.recon.voxel_size_m * 1000:g}mm"
+    key = config_record(config.recon)
+    if not (folder / "mesh.ply").is_file() or _stored(folder / RECONSTRUCTION_KEY) != key:
+        save_reconstruction(reconstruct_dataset(full, config.recon), folder)
+        write_json(folder / RECONSTRUCTION_KEY, key)
+    return folder / "mesh.ply"
+
+
+def _stored(path: Path) -> dict | None:
+    return json.loads(path.read_text()) if path.is_file() else None
+
+
+def plan_scan(config: PlanConfig) -> dict:
+    """Run the whole `nbv plan` pipeline; return the plan.json document (planner, views, metrics).
+
+    `out/metrics.json` is written by `nbv evaluate`'s own function, in its format.
+    """
+    out = Path(config.out)
+    check_output_folder(out, config.overwrite)
+    planner = make_planner(config.planner, config.seed, config.candidates)
+    views, plan_s = choose_views(config, planner, planning_env_config(config, planner))
+    scene = config.scene.load()
+    out.mkdir(parents=True, exist_ok=True)
+    settings = replace(config.render, seed=config.seed)
+    meta = {"planner": config.planner, "up_axis": config.scene.up_axis}
+    dataset = capture_dataset(scene, config.camera, views, out / "views", settings, config.render.variant,
+                              meta, overwrite=True, progress=False)
+    recon = reconstruct_dataset(read_dataset(dataset), config.recon)
+    mesh_path, _ = save_reconstruction(recon, out)
+    gt_path = out / "gt.ply"
+    scene.target_mesh().export(gt_path)
+    gt = GroundTruth(gt=str(gt_path))  # the normalised target: z up whatever the scene file's axis
+    results = evaluate(EvaluateConfig(mesh=mesh_path, reference=reference_mesh(config, scene),
+                                      ground_truth=gt, out=out, metrics=config.metrics, seed=config.seed,
+                                      overwrite=True))
+    doc = {"planner": config.planner, "scene": config.scene.scene, "views": len(views), "planning_s": plan_s,
+           "viewpoints": [v.as_array().tolist() for v in views],
+           "config": config_record(config),
+           **{name: result.as_dict() for name, result in results.items()}}
+    write_json(out / "plan.json", doc)
+    poses = np.stack([viewpoint_to_c2w(v, scene.center()) for v in views])
+    plot_trajectory(poses, scene.target_mesh(), out / "trajectory.png",
+                    title=f"{config.planner} on {Path(config.scene.scene).name}: {len(views)} views",
+                    numbered=True)
+    return doc

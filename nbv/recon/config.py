@@ -1,0 +1,99 @@
+"""Reconstruction, metrics and heat-map configs, declared once (light: no Open3D, no plotting).
+
+`docs/reconstruction.md` states the definitions these settings feed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Annotated, Literal
+
+from tyro.conf import Suppress, arg
+
+
+@dataclass(frozen=True)
+class ReconstructionConfig:
+    """TSDF fusion settings; the defaults suit a normalised 1 m target (docs/reconstruction.md)."""
+
+    voxel_size_m: float = 0.004
+    """Voxel edge length in metres (4 mm: 250 voxels across a 1 m target). Keep it above about a
+    third of a pixel's footprint on the target (at 2 m: 6.4 mm at 320 px wide, 13 mm at 160 px)."""
+    truncation_m: float = 0.016
+    """TSDF truncation distance in metres (4 voxels): the band fused around each depth sample."""
+    depth_max_m: float = 10.0
+    """Depth samples farther than this (metres) are ignored."""
+    min_observations: int = 1
+    """Voxels fused from fewer views than this are left out of the mesh and the point cloud."""
+    color: bool = True
+    """Fuse colours into the mesh and points (about a third of the fusion time); off: geometry only."""
+    crop_ground: bool = True
+    """Remove the ground plane z = 0 (depth points and reconstructed surface below the crop height)."""
+    ground_crop_voxels: float = 1.0
+    """Crop height above z = 0, in voxels: mesh vertices and points lower than this are removed."""
+    block_resolution: int = 8
+    """Voxels per side of one hashed block (8: 3.2 cm blocks, half the work of 16 on thin bands)."""
+    initial_blocks: int = 4000
+    """Voxel blocks allocated up front; the hash map grows beyond this when needed."""
+    device: Annotated[Literal["auto", "CPU:0", "CUDA:0"], arg(name="tsdf-device")] = "auto"
+    """Open3D device: 'auto' takes CUDA:0 where Open3D sees a CUDA GPU, else the CPU."""
+
+    def __post_init__(self) -> None:
+        for name in ("voxel_size_m", "truncation_m", "depth_max_m"):
+            value = getattr(self, name)
+            if not math.isfinite(value) or value <= 0:
+                raise ValueError(f"reconstruction {name} must be positive and finite, got {value!r}")
+        if self.truncation_m < self.voxel_size_m:
+            raise ValueError(f"reconstruction truncation_m ({self.truncation_m}) must be at least "
+                             f"one voxel ({self.voxel_size_m})")
+        if self.min_observations < 1:
+            raise ValueError(f"reconstruction min_observations must be >= 1, got {self.min_observations}")
+        if not math.isfinite(self.ground_crop_voxels) or self.ground_crop_voxels < 0:
+            raise ValueError(f"reconstruction ground_crop_voxels must be >= 0, got {self.ground_crop_voxels}")
+        if self.block_resolution < 2 or self.initial_blocks < 1:
+            raise ValueError("reconstruction block_resolution must be >= 2 and initial_blocks >= 1")
+
+    @property
+    def ground_crop_m(self) -> float:
+        """Crop height above the ground in metres (0 when the ground is kept)."""
+        return self.ground_crop_voxels * self.voxel_size_m if self.crop_ground else 0.0
+
+
+@dataclass(frozen=True)
+class MetricsConfig:
+    """How surfaces are sampled and compared."""
+
+    n_points: Annotated[int, arg(aliases=("--metric-points",))] = 1_000_000
+    """Points sampled from each surface (point clouds holding fewer are used whole)."""
+    threshold_cm: float = 1.0
+    """Distance threshold of coverage, precision, recall and F-score, in centimetres."""
+    seed: Suppress[int] = 0
+    """Seed of the surface sampling (the same for both surfaces); set from each command's --seed."""
+
+    def __post_init__(self) -> None:
+        if self.n_points < 1:
+            raise ValueError(f"metrics n_points must be >= 1, got {self.n_points}")
+        if not math.isfinite(self.threshold_cm) or self.threshold_cm <= 0:
+            raise ValueError(f"metrics threshold_cm must be positive, got {self.threshold_cm}")
+
+
+@dataclass(frozen=True)
+class HeatmapConfig:
+    """Colour scale and views of a heat map."""
+
+    max_cm: float = 2.0
+    """Distance at the top of the colour scale, cm (larger distances get the top colour)."""
+    colormap: str = "jet"
+    """Matplotlib colour map (CloudCompare's default scale is blue-green-yellow-red)."""
+    views: tuple[float, ...] = (45.0, 135.0, 225.0, 315.0)
+    """Azimuths (degrees, counter-clockwise from +x) of the views in the PNG."""
+    elevation_deg: float = 30.0
+    """Elevation of every view above the horizon, degrees."""
+    max_faces: int = 30_000
+    """Meshes with more faces are simplified (vertex clustering) for the PNG only."""
+
+    def __post_init__(self) -> None:
+        if not math.isfinite(self.max_cm) or self.max_cm <= 0:
+            raise ValueError(f"heat map max_cm must be positive, got {self.max_cm}")
+        if not self.views:
+            raise ValueError("heat map needs at least one view")

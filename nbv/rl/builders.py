@@ -1,0 +1,84 @@
+"""Builders of `nbv train`, one per concern (the TorchRL sota-implementations/sac layout).
+
+Each takes its group of `nbv.rl.config` (defaults: the paper's Table 1, docs/rl.md §8).
+"""
+
+from __future__ import annotations
+
+from functools import partial
+
+import torch
+from torchrl.collectors import Collector
+from torchrl.data import ListStorage, TensorDictReplayBuffer
+from torchrl.data.replay_buffers import RandomSampler
+from torchrl.envs import EnvBase, ParallelEnv, RewardSum, TransformedEnv
+from torchrl.modules import ProbabilisticActor, ValueOperator
+from torchrl.objectives import SACLoss, SoftUpdate
+
+from nbv.rl.agent import make_actor, make_critic
+from nbv.rl.config import (
+    CollectorConfig,
+    EnvConfig,
+    NetworkConfig,
+    OptimConfig,
+    ReplayBufferConfig,
+)
+from nbv.rl.env import NBVEnv
+
+
+def make_environment(config: EnvConfig, envs: int, seed: int) -> EnvBase:
+    """The training env: an in-process `NBVEnv` or a `ParallelEnv` of spawned workers, returns summed.
+
+    Worker i is seeded `seed + i` and starts its scene cycle at scene i. The scenes are
+    loaded once here first, so a bad scene name fails in this process with a clear message
+    rather than inside a worker.
+    """
+    for spec in config.scenes.specs():
+        spec.load()
+    if envs == 1:
+        base: EnvBase = NBVEnv(config, 0, seed)
+    else:
+        base = ParallelEnv(envs, [partial(NBVEnv, config, i, seed + i) for i in range(envs)],
+                           mp_start_method="spawn", serial_for_single=True)
+    return TransformedEnv(base, RewardSum())
+
+
+def make_sac_agent(env: EnvConfig, network: NetworkConfig) -> tuple[ProbabilisticActor, ValueOperator]:
+    """The actor and one critic (SACLoss clones it into the twin Q networks)."""
+    return make_actor(env.history, env.obs_size, network), make_critic(env.history, env.obs_size, network)
+
+
+def make_loss_module(actor: ProbabilisticActor, critic: ValueOperator,
+                     config: OptimConfig) -> tuple[SACLoss, SoftUpdate]:
+    """SAC (v2, no state-value network) with twin critics and fixed alpha, and its target updater."""
+    loss = SACLoss(actor, critic, num_qvalue_nets=2, loss_function="l2", alpha_init=config.alpha,
+                   fixed_alpha=True, action_spec=actor.spec["action"])
+    loss.make_value_estimator(gamma=config.gamma)
+    return loss, SoftUpdate(loss, tau=config.target_tau)
+
+
+def make_optimizers(loss: SACLoss, config: OptimConfig) -> tuple[torch.optim.Adam, torch.optim.Adam]:
+    """Adam for the actor and for the twin critics (alpha is fixed: no temperature optimiser)."""
+    actor = torch.optim.Adam(_trainable(loss.actor_network_params), lr=config.lr)
+    critic = torch.optim.Adam(_trainable(loss.qvalue_network_params), lr=config.lr)
+    return actor, critic
+
+
+def _trainable(params) -> list[torch.Tensor]:
+    return [p for p in params.values(True, True) if p.requires_grad]
+
+
+def make_replay_buffer(config: ReplayBufferConfig) -> TensorDictReplayBuffer:
+    """Uniform replay over a list storage (grows as filled; sampling uses torch's global RNG)."""
+    return TensorDictReplayBuffer(storage=ListStorage(max_size=config.buffer_size), sampler=RandomSampler(),
+                                  batch_size=config.batch_size)
+
+
+def make_collector(env: EnvBase, actor: ProbabilisticActor, config: CollectorConfig,
+                   frames_done: int = 0) -> Collector:
+    """A collector for the frames still to collect; random actions until `init_random_frames` overall."""
+    remaining_random = max(0, config.init_random_frames - frames_done)
+    remaining_random = -(-remaining_random // config.frames_per_batch) * config.frames_per_batch
+    return Collector(env, actor, frames_per_batch=config.frames_per_batch,
+                     total_frames=config.frames - frames_done, init_random_frames=remaining_random,
+                     track_traj_ids=False, auto_register_policy_transforms=False)

@@ -1,0 +1,108 @@
+"""Training checkpoints: written atomically, read with `torch.load(weights_only=True)`, validated.
+
+A checkpoint is a plain dict of tensors, numbers, strings and containers of
+them (nothing that needs pickle's arbitrary code): the run's config as JSON,
+the state dicts of the loss module (actor, twin critics, targets), optimisers
+and replay buffer, the counters, the random states of torch, NumPy and Python,
+and, for a one-worker run, the env's runtime state. Loading a truncated or
+foreign file, or one whose config the run cannot continue, raises
+`CheckpointError` naming the file and the reason.
+"""
+
+from __future__ import annotations
+
+import json
+import pickle
+import random
+import zipfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+
+from common.io import atomic_path
+
+FORMAT = "nbv-sac-checkpoint"
+VERSION = 1
+REQUIRED = ("format", "version", "config", "loss", "optim_actor", "optim_critic", "buffer", "counters", "rng")
+
+
+class CheckpointError(ValueError):
+    """A checkpoint is missing, corrupt, of another format, or does not fit the run loading it."""
+
+
+def rng_state() -> dict[str, Any]:
+    """The global random states of torch, NumPy and Python, as weights_only-loadable values."""
+    kind, keys, pos, has_gauss, gauss = np.random.get_state()
+    return {"torch": torch.get_rng_state(),
+            "numpy": {"kind": kind, "keys": torch.from_numpy(keys.astype(np.int64)), "pos": int(pos),
+                      "has_gauss": int(has_gauss), "gauss": float(gauss)},
+            "python": random.getstate()}
+
+
+def set_rng_state(state: dict[str, Any]) -> None:
+    """Restore what `rng_state` returned."""
+    torch.set_rng_state(state["torch"])
+    n = state["numpy"]
+    keys = n["keys"].numpy().astype(np.uint32)
+    np.random.set_state((n["kind"], keys, n["pos"], n["has_gauss"], n["gauss"]))
+    version, internal, gauss = state["python"]
+    random.setstate((version, tuple(internal), gauss))
+
+
+def seed_everything(seed: int) -> None:
+    """Seed torch, NumPy and Python's global generators."""
+    torch.manual_seed(seed)
+    np.random.seed(seed)
+    random.seed(seed)
+
+
+def save_checkpoint(path: str | Path, state: dict[str, Any]) -> Path:
+    """Write `state` (tagged with format and version) atomically to `path`."""
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        torch.save({"format": FORMAT, "version": VERSION, **state}, tmp)
+    return path
+
+
+def load_checkpoint(path: str | Path) -> dict[str, Any]:
+    """Read and validate a checkpoint written by `save_checkpoint` (weights_only: no code runs)."""
+    path = Path(path)
+    if not path.is_file():
+        raise CheckpointError(f"checkpoint {path} not found")
+    try:
+        state = torch.load(path, map_location="cpu", weights_only=True)
+    except (RuntimeError, EOFError, OSError, zipfile.BadZipFile, pickle.UnpicklingError, ValueError) as err:
+        raise CheckpointError(f"checkpoint {path} is corrupt or not a checkpoint: {err}") from err
+    if not isinstance(state, dict) or state.get("format") != FORMAT:
+        raise CheckpointError(f"checkpoint {path} is not an nbv SAC checkpoint")
+    if state.get("version") != VERSION:
+        raise CheckpointError(f"checkpoint {path} has version {state.get('version')}, "
+                              f"this toolkit reads {VERSION}")
+    missing = [key for key in REQUIRED if key not in state]
+    if missing:
+        raise CheckpointError(f"checkpoint {path} lacks {', '.join(missing)}")
+    return state
+
+
+def checkpoint_config(state: dict[str, Any]) -> dict[str, Any]:
+    """The run config stored in a checkpoint, as a nested dict."""
+    return json.loads(state["config"])
+
+
+def check_compatible(path: str | Path, saved: dict[str, Any], current: dict[str, Any],
+                     free: tuple[str, ...]) -> None:
+    """Raise `CheckpointError` listing every setting that differs, except the `free` (dotted) ones."""
+    diffs = [f"{key}: checkpoint {a!r}, now {b!r}" for key, a, b in _diff(saved, current) if key not in free]
+    if diffs:
+        raise CheckpointError(f"checkpoint {path} does not match this run's settings ({'; '.join(diffs)})")
+
+
+def _diff(a: Any, b: Any, prefix: str = "") -> list[tuple[str, Any, Any]]:
+    if isinstance(a, dict) and isinstance(b, dict):
+        out = []
+        for key in sorted(set(a) | set(b)):
+            out += _diff(a.get(key), b.get(key), f"{prefix}{key}.")
+        return out
+    return [] if a == b else [(prefix.rstrip("."), a, b)]

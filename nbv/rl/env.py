@@ -1,0 +1,253 @@
+"""The online next-best-view problem as a TorchRL environment (paper Sec. IV; docs/rl.md).
+
+State: the last `history` (tau = 5) grayscale frames, downsampled to
+`obs_size` x `obs_size` (uint8, key `pixels`), and the last `history`
+viewpoints (R, azimuth, elevation), each normalised to [-1, 1] over its allowed
+range (key `viewpoints`). At reset both histories hold copies of the first view.
+
+Action: three values in [-1, 1]. In the paper's `absolute` mode they are the
+next viewpoint itself, rescaled to the allowed ranges of R, azimuth and
+elevation ("rescaled to conform to the specified ranges", Sec. IV); in the
+`relative` mode they are a step from the current viewpoint, at most
+`relative_step` of each range, clipped to the ranges; in the `orbit` mode
+the azimuth is such a step and R and elevation are absolute. Orbit exists
+because absolute azimuth is a circular target that a tanh output cannot
+follow across 0 = 2 pi (moving on by 45 degrees from 350 needs an action
+jump from +1 to -1), and it keeps R and elevation free of the drift of
+relative steps (measured, with unscaled rewards: a relative policy flew
+every view at R = 1.5 m, 5 degrees up; on the held-out chalet those close,
+low views happened to cover the surface best, see paper_results/planners).
+
+Reward: the Bag of Views reward of the new view (vocabulary change - 1,
+docs/bov.md), from the config's `bov` (its match cosine included). The BoV is
+emptied at each reset and learns the episode's first view without reward.
+
+Termination: one pass around the target, i.e. the net azimuth travelled
+(each step's change wrapped to (-pi, pi]) reaches 2 pi in either direction.
+Truncation: `max_steps` steps.
+
+Rendering: one renderer per scene (loaded with the scene set's up axis),
+created lazily on the first reset, in the process that steps the env, so
+`ParallelEnv`'s spawned workers each choose their own Mitsuba variant; view k
+is rendered with the config's render settings' `view_seed(k)` under the env's
+seed. The constructor takes only picklable settings.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import Any
+
+import cv2
+import numpy as np
+import torch
+from tensordict import TensorDict, TensorDictBase
+from torchrl.data import Bounded, Categorical, Composite, Unbounded
+from torchrl.envs import EnvBase
+
+from nbv.bov.bag import BagOfViews
+from nbv.features.sift import extract_features
+from nbv.rl.config import EnvConfig
+from render.renderer import MitsubaRenderer
+from render.viewpoint import TWO_PI, Viewpoint, viewpoint_to_c2w
+from scenes.spec import SceneSpec
+
+
+def check_action(action: Any) -> np.ndarray:
+    """The action as float64 (3,), or a ValueError if it is NaN, infinite or outside [-1, 1]."""
+    a = np.asarray(action.detach().cpu() if isinstance(action, torch.Tensor) else action, dtype=np.float64)
+    if a.shape != (3,):
+        raise ValueError(f"an NBV action has 3 values (R, azimuth, elevation), got shape {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"NBV action contains NaN or infinite values: {a.tolist()}")
+    if np.any(np.abs(a) > 1.0 + 1e-6):
+        raise ValueError(f"NBV action must lie in [-1, 1], got {a.tolist()}")
+    return np.clip(a, -1.0, 1.0)
+
+
+def normalise_viewpoint(view: Viewpoint, config: EnvConfig) -> np.ndarray:
+    """(R, azimuth, elevation) mapped to [-1, 1] over the allowed ranges (the inverse of `absolute`)."""
+    return 2.0 * (view.as_array() - config.low) / np.maximum(config.high - config.low, 1e-12) - 1.0
+
+
+def action_to_viewpoint(action: Any, current: Viewpoint, config: EnvConfig) -> Viewpoint:
+    """The next viewpoint an action asks for, under the config's action mode."""
+    a = check_action(action)
+    low, high = config.low, config.high
+    absolute = low + (a + 1.0) / 2.0 * (high - low)
+    step = current.as_array() + a * config.relative_step * (high - low)
+    if config.action_mode == "absolute":
+        r, az, el = absolute
+    elif config.action_mode == "orbit":
+        r, az, el = absolute[0], step[1], absolute[2]
+    else:
+        r, az, el = step
+        r, el = np.clip(r, low[0], high[0]), np.clip(el, low[2], high[2])
+    return Viewpoint(float(r), float(az) % TWO_PI, float(el))
+
+
+def wrap_angle(angle: float) -> float:
+    """An angle difference wrapped to (-pi, pi]."""
+    wrapped = math.remainder(angle, TWO_PI)
+    return math.pi if wrapped == -math.pi else wrapped
+
+
+def gray_frame(rgb: np.ndarray, size: int) -> np.ndarray:
+    """An sRGB uint8 image as a `size` x `size` uint8 grayscale frame (area-averaged)."""
+    gray = cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY)
+    return cv2.resize(gray, (size, size), interpolation=cv2.INTER_AREA)
+
+
+class NBVEnv(EnvBase):
+    """Next-best-view planning around one target at a time, rewarded by the Bag of Views.
+
+    Args:
+        config: scenes, camera, allowed ranges, episode and Bag of Views settings.
+        worker: index of this env among parallel workers; it offsets the scene order.
+        seed: seed of the start viewpoints, the render noise and the BoV clustering.
+
+    Example:
+        >>> from render.camera import UAVCamera
+        >>> from scenes.spec import SceneSet
+        >>> scenes = SceneSet(scene=("test_building",))
+        >>> env = NBVEnv(EnvConfig(scenes=scenes, camera=UAVCamera(64, 48), obs_size=32))
+        >>> td = env.rollout(3)
+    """
+
+    def __init__(self, config: EnvConfig, worker: int = 0, seed: int = 0) -> None:
+        super().__init__(device="cpu", batch_size=torch.Size([]))
+        self.config = config
+        self.worker = worker
+        tau, side = config.history, config.obs_size
+        self.observation_spec = Composite(
+            pixels=Bounded(0, 255, shape=(tau, side, side), dtype=torch.uint8),
+            viewpoints=Bounded(-1.0, 1.0, shape=(tau, 3), dtype=torch.float32),
+        )
+        self.action_spec = Bounded(-1.0, 1.0, shape=(3,), dtype=torch.float32)
+        self.reward_spec = Unbounded(shape=(1,), dtype=torch.float32)
+        self.done_spec = Composite(
+            done=Categorical(2, shape=(1,), dtype=torch.bool),
+            terminated=Categorical(2, shape=(1,), dtype=torch.bool),
+            truncated=Categorical(2, shape=(1,), dtype=torch.bool),
+        )
+        self._scenes = config.scenes.specs()
+        self._renderers: dict[str, MitsubaRenderer] = {}
+        self._features = config.bov.feature_config()
+        self._bov: BagOfViews | None = None
+        self._resume_pending = False
+        self._view: Viewpoint | None = None
+        self._set_seed(seed)
+
+    # -- TorchRL hooks -------------------------------------------------------------------------
+
+    def _set_seed(self, seed: int | None) -> None:
+        self._seed = int(seed or 0)
+        self._render = replace(self.config.render, seed=self._seed)
+        self._rng = np.random.default_rng(self._seed)
+        self._episode = 0
+        self._views_rendered = 0
+        self._bov = None
+
+    def _reset(self, tensordict: TensorDictBase | None = None, **kwargs) -> TensorDictBase:
+        if self._resume_pending:
+            # A restored snapshot continues its episode: the collector's first reset resumes it.
+            self._resume_pending = False
+            return self._observation()
+        self._scene = self._scenes[(self.worker + self._episode) % len(self._scenes)]
+        self._episode += 1
+        low, high = self.config.low, self.config.high
+        radius, azimuth, elevation = low + self._rng.random(3) * (high - low)
+        self._view = Viewpoint(float(radius), float(azimuth), float(elevation))
+        self.bov.reset()
+        frame, descriptors = self.capture(self._view)
+        self.bov.update(descriptors, self._view.azimuth)
+        location = normalise_viewpoint(self._view, self.config)
+        self._frames = np.repeat(frame[None], self.config.history, axis=0)
+        self._locations = np.repeat(location[None], self.config.history, axis=0)
+        self._progress = 0.0
+        self._steps = 0
+        return self._observation()
+
+    def _step(self, tensordict: TensorDictBase) -> TensorDictBase:
+        view = action_to_viewpoint(tensordict["action"], self._view, self.config)
+        frame, descriptors = self.capture(view)
+        reward = self.bov.reward(descriptors, view.azimuth)
+        self._progress += wrap_angle(view.azimuth - self._view.azimuth)
+        self._view = view
+        self._steps += 1
+        self._frames = np.concatenate([self._frames[1:], frame[None]])
+        self._locations = np.concatenate([self._locations[1:], normalise_viewpoint(view, self.config)[None]])
+        terminated = abs(self._progress) >= TWO_PI - 1e-9
+        truncated = not terminated and self._steps >= self.config.max_steps
+        out = self._observation(terminated, truncated)
+        out.set("reward", torch.tensor([reward], dtype=torch.float32))
+        return out
+
+    # -- state ---------------------------------------------------------------------------------
+
+    @property
+    def bov(self) -> BagOfViews:
+        """The episode's Bag of Views (created on first use)."""
+        if self._bov is None:
+            self._bov = self.config.bov.bag(seed=self._seed)
+        return self._bov
+
+    @property
+    def viewpoint(self) -> Viewpoint | None:
+        """The current camera viewpoint (None before the first reset)."""
+        return self._view
+
+    def snapshot(self) -> dict[str, Any]:
+        """The env's full runtime state (episode, histories, RNG, BoV), loadable with weights_only."""
+        if self._view is None:
+            raise RuntimeError("NBVEnv.snapshot needs an episode: call reset() first")
+        return {
+            "seed": self._seed, "episode": self._episode, "views_rendered": self._views_rendered,
+            "rng": self._rng.bit_generator.state, "scene": self._scene.scene,
+            "view": self._view.as_array().tolist(), "frames": torch.from_numpy(self._frames.copy()),
+            "locations": torch.from_numpy(self._locations.copy()),
+            "progress": self._progress, "steps": self._steps, "bov": self.bov.state_dict(),
+        }
+
+    def restore(self, state: dict[str, Any]) -> None:
+        """Load a `snapshot`; the next reset continues the restored episode instead of starting one."""
+        self._set_seed(state["seed"])
+        self._episode, self._views_rendered = int(state["episode"]), int(state["views_rendered"])
+        self._rng.bit_generator.state = state["rng"]
+        self._scene = SceneSpec(scene=str(state["scene"]), up_axis=self.config.scenes.up_axis)
+        self._view = Viewpoint(*map(float, state["view"]))
+        self._frames, self._locations = state["frames"].numpy().copy(), state["locations"].numpy().copy()
+        self._progress, self._steps = float(state["progress"]), int(state["steps"])
+        self.bov.load_state_dict(state["bov"])
+        self._resume_pending = True
+
+    # -- rendering -----------------------------------------------------------------------------
+
+    def render_view(self, view: Viewpoint) -> np.ndarray:
+        """The sRGB image at `view` of the current scene (advances the per-view render seed)."""
+        renderer = self._renderer(self._scene)
+        seed = self._render.view_seed(self._views_rendered)
+        self._views_rendered += 1
+        return renderer.render_rgb(viewpoint_to_c2w(view, renderer.center), seed=seed)
+
+    def capture(self, view: Viewpoint) -> tuple[np.ndarray, torch.Tensor]:
+        """Render `view` of the current scene: its policy frame (S x S uint8), SIFT descriptors (M, 128)."""
+        rgb = self.render_view(view)
+        descriptors = torch.as_tensor(extract_features([rgb], self._features)[0].descriptors)
+        return gray_frame(rgb, self.config.obs_size), descriptors
+
+    def _renderer(self, spec: SceneSpec) -> MitsubaRenderer:
+        if spec.scene not in self._renderers:
+            self._renderers[spec.scene] = MitsubaRenderer(spec.load(), self.config.camera, self._render)
+        return self._renderers[spec.scene]
+
+    def _observation(self, terminated: bool = False, truncated: bool = False) -> TensorDict:
+        return TensorDict({
+            "pixels": torch.from_numpy(self._frames.copy()),
+            "viewpoints": torch.from_numpy(self._locations.astype(np.float32)),
+            "done": torch.tensor([terminated or truncated]),
+            "terminated": torch.tensor([terminated]),
+            "truncated": torch.tensor([truncated]),
+        }, batch_size=self.batch_size)
+

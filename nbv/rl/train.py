@@ -1,0 +1,185 @@
+"""`nbv train`: Soft Actor-Critic over the NBV environment (paper Sec. IV-V-A, Table 1).
+
+The loop, top to bottom: build env, networks, loss, optimisers, buffer;
+restore the run folder's checkpoint if there is one; then collect a batch,
+store it, take gradient steps (soft-updating the target critics every
+`target_update_interval` steps), log, and checkpoint (with `training.png`,
+the learning curves so far).
+
+Exact resumption: checkpoints are taken between iterations and hold
+everything the rest of the run depends on: networks, optimisers, replay
+buffer, counters, torch / NumPy / Python random states and, with one worker
+(in-process), the env's own state (episode in progress, render seed counter,
+start-view RNG, Bag of Views). So a one-worker run stopped and resumed ends
+with the same parameters as one that ran through. With parallel workers the
+workers' episodes in flight are lost at a restart: they start new episodes,
+seeded `seed + frames done`, and everything else resumes exactly.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import time
+from pathlib import Path
+
+import torch
+from tensordict import TensorDictBase
+from torch.utils.tensorboard import SummaryWriter
+from torchrl.data import ReplayBuffer
+from torchrl.objectives import SACLoss
+from tqdm import tqdm
+
+from common.io import write_json
+from common.provenance import config_record
+from nbv.rl.builders import (
+    make_collector,
+    make_environment,
+    make_loss_module,
+    make_optimizers,
+    make_replay_buffer,
+    make_sac_agent,
+)
+from nbv.rl.checkpoint import (
+    check_compatible,
+    checkpoint_config,
+    load_checkpoint,
+    rng_state,
+    save_checkpoint,
+    seed_everything,
+    set_rng_state,
+)
+from nbv.rl.config import TrainConfig
+from nbv.rl.env import NBVEnv
+from nbv.viz.figures import plot_training_curves
+
+CHECKPOINT = "checkpoint.pt"
+RESUMABLE_CHANGES = ("collector.frames", "logger.out", "logger.checkpoint_every", "logger.progress")
+"""Settings a resumed run may change, as dotted paths into the nested config record (a difference
+anywhere else, e.g. `env.bov.match_cosine` or `env.camera.width`, is refused)."""
+CSV_FIELDS = ("frames", "updates", "reward_mean", "episode_return", "episodes", "loss_actor", "loss_qvalue",
+              "entropy", "collect_s", "update_s")
+
+
+def train(config: TrainConfig) -> Path:
+    """Train (or resume training) into `config.logger.out`; return the checkpoint path."""
+    run = Path(config.logger.out)
+    run.mkdir(parents=True, exist_ok=True)
+    ckpt_path = run / CHECKPOINT
+    resumed = load_checkpoint(ckpt_path) if ckpt_path.exists() else None
+    if resumed is not None:
+        check_compatible(ckpt_path, checkpoint_config(resumed), config_record(config), RESUMABLE_CHANGES)
+    write_json(run / "config.json", config_record(config))
+    seed = config.collector.seed
+    seed_everything(seed)
+    if config.collector.threads:
+        torch.set_num_threads(config.collector.threads)
+
+    # Networks, loss, optimisers, replay buffer.
+    actor, critic = make_sac_agent(config.env, config.network)
+    loss_module, target_updater = make_loss_module(actor, critic, config.optim)
+    optim_actor, optim_critic = make_optimizers(loss_module, config.optim)
+    buffer = make_replay_buffer(config.replay_buffer)
+    frames, updates = 0, 0
+    if resumed is not None:
+        loss_module.load_state_dict(resumed["loss"])
+        optim_actor.load_state_dict(resumed["optim_actor"])
+        optim_critic.load_state_dict(resumed["optim_critic"])
+        buffer.load_state_dict(resumed["buffer"])
+        frames, updates = int(resumed["counters"]["frames"]), int(resumed["counters"]["updates"])
+        if frames >= config.collector.frames:
+            return ckpt_path  # the budget is already spent: nothing to do
+
+    # Environment and collector (random actions until init_random_frames).
+    envs = config.collector.envs
+    env = make_environment(config.env, envs, seed + frames)
+    if resumed is not None and envs == 1:
+        env.base_env.restore(resumed["env"])
+    collector = make_collector(env, actor, config.collector, frames)
+    if resumed is not None:
+        set_rng_state(resumed["rng"])  # after every builder: construction draws random numbers too
+
+    writer = SummaryWriter(str(run / "tensorboard"))
+    csv_path = run / "metrics.csv"
+    new_csv = not csv_path.exists()
+    updates_per_batch = round(config.collector.frames_per_batch * config.optim.updates_per_frame)
+    last_ckpt = frames
+    bar = tqdm(total=config.collector.frames, initial=frames, unit="frame", desc=f"train {run.name}",
+               disable=not config.logger.progress)
+    try:
+        with open(csv_path, "a", newline="") as csv_file:
+            log = csv.DictWriter(csv_file, CSV_FIELDS)
+            if new_csv:
+                log.writeheader()
+            start = time.perf_counter()
+            for batch in collector:
+                collect_s = time.perf_counter() - start
+                batch = batch.reshape(-1)
+                buffer.extend(batch)
+                frames += batch.numel()
+
+                # Gradient steps once the random warm-up is over (Table 1 settings).
+                start = time.perf_counter()
+                losses = {}
+                if frames >= config.collector.init_random_frames:
+                    for _ in range(updates_per_batch):
+                        losses = sac_update(loss_module, optim_actor, optim_critic, buffer.sample(),
+                                            config.optim.reward_scale)
+                        updates += 1
+                        if updates % config.optim.target_update_interval == 0:
+                            target_updater.step()
+                update_s = time.perf_counter() - start
+
+                done = batch["next", "done"].squeeze(-1)
+                returns = batch["next", "episode_reward"][done]
+                row = {"frames": frames, "updates": updates,
+                       "reward_mean": batch["next", "reward"].mean().item(),
+                       "episode_return": returns.mean().item() if done.any() else "",
+                       "episodes": int(done.sum()), "collect_s": collect_s, "update_s": update_s, **losses}
+                log.writerow(row)
+                for key, value in row.items():
+                    if key != "frames" and value != "":
+                        writer.add_scalar(f"train/{key}", value, frames)
+                bar.update(batch.numel())
+                bar.set_postfix(reward=f"{row['reward_mean']:.2f}", updates=updates)
+
+                if frames - last_ckpt >= config.logger.checkpoint_every or frames >= config.collector.frames:
+                    csv_file.flush()
+                    plot_training_curves({run.name: csv_path}, run / "training.png")
+                    write_checkpoint(ckpt_path, config, loss_module, optim_actor, optim_critic, buffer,
+                                     frames, updates, env.base_env if envs == 1 else None)
+                    last_ckpt = frames
+                start = time.perf_counter()
+    finally:
+        bar.close()
+        writer.close()
+        collector.shutdown()
+    return ckpt_path
+
+
+def sac_update(loss_module: SACLoss, optim_actor: torch.optim.Optimizer, optim_critic: torch.optim.Optimizer,
+               sample: TensorDictBase, reward_scale: float = 1.0) -> dict[str, float]:
+    """One SAC gradient step on a replay sample, rewards scaled (alpha fixed: its loss is not optimised)."""
+    if reward_scale != 1.0:
+        sample.set(("next", "reward"), sample["next", "reward"] * reward_scale)
+    losses = loss_module(sample)
+    optim_critic.zero_grad()
+    optim_actor.zero_grad()
+    (losses["loss_actor"] + losses["loss_qvalue"]).backward()
+    optim_critic.step()
+    optim_actor.step()
+    return {"loss_actor": losses["loss_actor"].item(), "loss_qvalue": losses["loss_qvalue"].item(),
+            "entropy": losses["entropy"].item()}
+
+
+def write_checkpoint(path: Path, config: TrainConfig, loss_module: SACLoss,
+                     optim_actor: torch.optim.Optimizer, optim_critic: torch.optim.Optimizer,
+                     buffer: ReplayBuffer, frames: int, updates: int, env: NBVEnv | None) -> Path:
+    """Save everything a resumed run needs (see the module docstring)."""
+    state = {"config": json.dumps(config_record(config)), "loss": loss_module.state_dict(),
+             "optim_actor": optim_actor.state_dict(), "optim_critic": optim_critic.state_dict(),
+             "buffer": buffer.state_dict(), "counters": {"frames": frames, "updates": updates},
+             "rng": rng_state()}
+    if env is not None:
+        state["env"] = env.snapshot()
+    return save_checkpoint(path, state)

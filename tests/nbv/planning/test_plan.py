@@ -1,0 +1,67 @@
+"""`nbv plan` end to end, tiny: views dataset, reconstruction, metrics.json, trajectory.png."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+from nbv.bov.config import BoVConfig
+from nbv.cli import main
+from nbv.planning.plan import PlanConfig, planning_env_config, reference_mesh
+from nbv.planning.planners import make_planner
+from nbv.recon.config import ReconstructionConfig
+from nbv.rl.env import NBVEnv
+from render.camera import UAVCamera
+from render.dataset import read_dataset
+from render.settings import RenderSettings
+from scenes import load_scene
+from scenes.spec import SceneSet, SceneSpec
+
+
+def test_nbv_plan_end_to_end(tmp_path, capsys):
+    reference = tmp_path / "reference.ply"
+    load_scene("test_building").target_mesh().export(reference)
+    out = tmp_path / "plan"
+    args = ["plan", "test_building", "--planner", "circle", "--views", "6", "--width", "64", "--height", "48",
+            "--spp", "1", "--reference", str(reference), "--metric-points", "3000", "--voxel-size-m", "0.01",
+            "--out", str(out)]
+    assert main(args) == 0
+    dataset = read_dataset(out / "views")
+    assert len(dataset) == 6 and dataset.meta["planner"] == "circle"
+    metrics = json.loads((out / "metrics.json").read_text())
+    for name in ("gt", "reference"):
+        assert 0.0 < metrics[name]["coverage"] <= 1.0
+        m = metrics[name]
+        assert 0 < m["chamfer_cm"] <= m["hausdorff_cm"]
+    plan = json.loads((out / "plan.json").read_text())
+    assert plan["views"] == 6 and len(plan["viewpoints"]) == 6 and plan["gt"] == metrics["gt"]
+    assert (out / "trajectory.png").stat().st_size > 10_000 and (out / "mesh.ply").is_file()
+    assert '"planner": "circle"' in capsys.readouterr().out
+    assert main(args) == 2  # refuses to overwrite without --overwrite
+
+
+def test_nbv_plan_unknown_planner_is_a_clear_error(tmp_path, capsys):
+    assert main(["plan", "test_building", "--planner", "best", "--out", str(tmp_path / "p")]) == 2
+    assert "unknown planner" in capsys.readouterr().err
+
+
+def test_reference_is_the_cached_full_scan_reconstruction(tmp_path):
+    recon = ReconstructionConfig(voxel_size_m=0.02, truncation_m=0.08)  # 4 voxels, as before
+    config = PlanConfig(scene=SceneSpec(scene="test_building"), out=tmp_path / "plan",
+                        camera=UAVCamera(48, 36), render=RenderSettings(spp=1), recon=recon)
+    path = reference_mesh(config)
+    assert path.name == "mesh.ply" and path.parent.name == "reconstruction_20mm"
+    assert len(read_dataset(path.parent.parent)) == 288  # the paper's full hemisphere scan
+    stamp = path.stat().st_mtime_ns
+    assert reference_mesh(config) == path and path.stat().st_mtime_ns == stamp  # reused, not rebuilt
+    other = replace(config, recon=replace(config.recon, truncation_m=0.06))
+    assert reference_mesh(other) == path and path.stat().st_mtime_ns != stamp  # other fusion settings: redone
+
+
+def test_the_plans_bov_and_camera_reach_the_greedy_planners_env(tmp_path):
+    config = PlanConfig(scene=SceneSpec(scene="house.obj", up_axis="y"), planner="greedy", out=tmp_path,
+                        camera=UAVCamera(64, 48, focal_mm=20.0), bov=BoVConfig(ranges=4, match_cosine=0.6))
+    env = NBVEnv(planning_env_config(config, make_planner("greedy")))
+    assert env.bov.match_cosine == 0.6 and env.bov.ranges == 4
+    assert env.config.camera.focal_mm == 20.0
+    assert env.config.scenes == SceneSet(scene=("house.obj",), up_axis="y")

@@ -1,0 +1,135 @@
+"""Planners: each returns valid viewpoints inside the allowed ranges, on one interface."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+import torch
+
+from nbv.bov.config import BoVConfig
+from nbv.planning.planners import (
+    CirclePlanner,
+    GreedyBoVPlanner,
+    HemispherePlanner,
+    PolicyPlanner,
+    RandomPlanner,
+    make_planner,
+    planner_label,
+)
+from nbv.rl.builders import make_loss_module, make_optimizers, make_replay_buffer, make_sac_agent
+from nbv.rl.checkpoint import CheckpointError, save_checkpoint
+from nbv.rl.config import EnvConfig, LoggerConfig, OptimConfig, TrainConfig
+from nbv.rl.env import NBVEnv
+from nbv.rl.train import write_checkpoint
+from render.camera import UAVCamera
+from render.settings import RenderSettings
+from render.viewpoint import Viewpoint
+from scenes.spec import SceneSet
+
+TEST_BUILDING = SceneSet(scene=("test_building",))
+
+
+def tiny_env(seed: int = 0, **kwargs) -> NBVEnv:
+    settings = dict(scenes=TEST_BUILDING, camera=UAVCamera(64, 48), render=RenderSettings(spp=1),
+                    bov=BoVConfig(ranges=8, features="opencv"), obs_size=32, max_steps=4)
+    config = EnvConfig(**{**settings, **kwargs})
+    return NBVEnv(config, seed=seed)
+
+
+def in_ranges(view: Viewpoint, config: EnvConfig) -> bool:
+    low, high = config.low, config.high
+    return (low[0] - 1e-9 <= view.radius <= high[0] + 1e-9 and 0 <= view.azimuth < 2 * math.pi
+            and low[2] - 1e-9 <= view.elevation <= high[2] + 1e-9)
+
+
+@pytest.mark.parametrize("planner", [RandomPlanner(seed=3), CirclePlanner(), GreedyBoVPlanner(candidates=2)])
+def test_baselines_return_the_asked_number_of_valid_views(planner):
+    env = tiny_env()
+    views = planner.plan(env, 3)
+    assert len(views) == 3 and all(isinstance(v, Viewpoint) and in_ranges(v, env.config) for v in views)
+
+
+def test_random_is_seeded_and_circle_is_evenly_spaced():
+    env = tiny_env()
+    assert RandomPlanner(seed=1).plan(env, 4) == RandomPlanner(seed=1).plan(env, 4)
+    assert RandomPlanner(seed=1).plan(env, 4) != RandomPlanner(seed=2).plan(env, 4)
+    circle = CirclePlanner().plan(env, 4)
+    assert [v.azimuth for v in circle] == pytest.approx([0, math.pi / 2, math.pi, 3 * math.pi / 2])
+    assert len(CirclePlanner().plan(env, None)) == 13
+
+
+def test_greedy_picks_the_candidate_of_highest_reward(monkeypatch):
+    env = tiny_env()
+    env.reset()
+    planner = GreedyBoVPlanner(candidates=3, seed=0)
+    rewards = iter([1.0, 5.0, 2.0])
+    chosen_candidates = []
+
+    def fake_capture(view):
+        chosen_candidates.append(view)
+        return None, torch.zeros(0, 128)
+
+    monkeypatch.setattr(env, "reset", lambda: None)
+    monkeypatch.setattr(env, "capture", fake_capture)
+    monkeypatch.setattr(type(env.bov), "reward", lambda self, d, az: next(rewards))
+    views = planner.plan(env, 2)
+    assert views[1] == chosen_candidates[1]
+
+
+def test_hemisphere_is_the_full_scan():
+    env = tiny_env()
+    views = HemispherePlanner().plan(env, None)
+    assert len(views) > 100 and all(v.radius == pytest.approx(2.0) for v in views)
+    with pytest.raises(ValueError, match="would cut it"):
+        HemispherePlanner().plan(env, 10)
+
+
+def save_untrained_policy(path, env: NBVEnv) -> None:
+    config = TrainConfig(env=env.config, logger=LoggerConfig(out=path.parent))
+    actor, critic = make_sac_agent(env.config, config.network)
+    loss, _ = make_loss_module(actor, critic, OptimConfig())
+    optim_actor, optim_critic = make_optimizers(loss, OptimConfig())
+    buffer = make_replay_buffer(config.replay_buffer)
+    write_checkpoint(path, config, loss, optim_actor, optim_critic, buffer, 0, 0, None)
+
+
+def test_policy_planner_from_checkpoint(tmp_path):
+    env = tiny_env(max_steps=3)
+    save_untrained_policy(tmp_path / "checkpoint.pt", env)
+    planner = make_planner(f"policy:{tmp_path / 'checkpoint.pt'}")
+    assert isinstance(planner, PolicyPlanner) and planner.env_config == env.config  # nested, rebuilt
+    views = planner.plan(env, None)  # until the episode ends: at most the step cap
+    assert 2 <= len(views) <= 4 and all(in_ranges(v, env.config) for v in views)
+    assert len(planner.plan(tiny_env(), 5)) == 5
+    with pytest.raises(ValueError, match="obs_size"):
+        planner.plan(NBVEnv(EnvConfig(scenes=TEST_BUILDING, obs_size=16)), 2)
+
+
+def test_sampled_policy_is_seeded_and_spread(tmp_path):
+    (tmp_path / "run").mkdir()
+    save_untrained_policy(tmp_path / "run" / "checkpoint.pt", tiny_env())
+    spec = f"policy-sample:{tmp_path / 'run' / 'checkpoint.pt'}"
+    sampled = make_planner(spec, seed=1)
+    assert isinstance(sampled, PolicyPlanner) and sampled.sample
+    first = sampled.plan(tiny_env(), 4)
+    assert first == make_planner(spec, seed=1).plan(tiny_env(), 4)  # seeded: the same draws
+    assert first != make_planner(spec, seed=2).plan(tiny_env(), 4)
+    assert all(in_ranges(v, tiny_env().config) for v in first)
+    mode = make_planner(f"policy:{tmp_path / 'run' / 'checkpoint.pt'}", seed=1).plan(tiny_env(), 4)
+    assert mode != first and mode == make_planner(f"policy:{tmp_path / 'run' / 'checkpoint.pt'}",
+                                                  seed=2).plan(tiny_env(), 4)  # the mode ignores the seed
+    assert planner_label(spec) == "policy-sample-run" and planner_label("greedy") == "greedy"
+
+
+def test_bad_planner_specs(tmp_path):
+    with pytest.raises(ValueError, match="unknown planner"):
+        make_planner("best")
+    with pytest.raises(CheckpointError, match="not found"):
+        make_planner("policy:/nonexistent/checkpoint.pt")
+    flat = {"env": {"scene": ["test_building"], "width": 64, "bov_ranges": 8}, "network": {}}  # old layout
+    save_checkpoint(tmp_path / "old.pt", {"config": json.dumps(flat), "loss": {}, "optim_actor": {},
+                                          "optim_critic": {}, "buffer": {}, "counters": {}, "rng": {}})
+    with pytest.raises(CheckpointError, match="config does not fit.*no field.*bov_ranges"):
+        make_planner(f"policy:{tmp_path / 'old.pt'}")

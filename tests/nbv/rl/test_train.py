@@ -1,0 +1,115 @@
+"""`nbv train`: tiny runs that checkpoint and resume; one worker resumes bit for bit."""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import replace
+
+import pytest
+import torch
+from PIL import Image
+from tensordict import TensorDict
+
+from nbv.bov.config import BoVConfig
+from nbv.cli import main
+from nbv.rl.builders import make_loss_module, make_optimizers, make_sac_agent
+from nbv.rl.checkpoint import CheckpointError, load_checkpoint
+from nbv.rl.config import CollectorConfig, EnvConfig, LoggerConfig, TrainConfig
+from nbv.rl.train import sac_update, train
+from render.camera import UAVCamera
+from render.settings import RenderSettings
+from scenes.spec import SceneSet
+
+TINY_ENV = ["--scene", "test_building", "--width", "64", "--height", "48", "--spp", "1", "--obs-size", "32",
+            "--max-steps", "3", "--feature-backend", "opencv"]
+
+
+def tiny(out, frames: int, **collector) -> TrainConfig:
+    env = EnvConfig(scenes=SceneSet(scene=("test_building",)), camera=UAVCamera(64, 48),
+                    render=RenderSettings(spp=1), bov=BoVConfig(ranges=8, features="opencv"), obs_size=32,
+                    max_steps=3)
+    settings = {"frames": frames, "frames_per_batch": 2, "init_random_frames": 2, "seed": 7, **collector}
+    return TrainConfig(env=env, collector=CollectorConfig(**settings),
+                       logger=LoggerConfig(out=out, checkpoint_every=1000, progress=False))
+
+
+def test_one_worker_interrupted_and_resumed_equals_uninterrupted(tmp_path):
+    train(tiny(tmp_path / "straight", 8))
+    train(tiny(tmp_path / "resumed", 4))
+    middle = load_checkpoint(tmp_path / "resumed" / "checkpoint.pt")
+    assert middle["counters"]["frames"] == 4 and middle["env"]["steps"] == 1  # stopped mid-episode
+    train(tiny(tmp_path / "resumed", 8))
+    train(tiny(tmp_path / "resumed", 8))  # budget spent: a no-op
+    a = load_checkpoint(tmp_path / "straight" / "checkpoint.pt")
+    b = load_checkpoint(tmp_path / "resumed" / "checkpoint.pt")
+    assert a["counters"] == b["counters"] == {"frames": 8, "updates": 8}
+    assert a["loss"].keys() == b["loss"].keys()
+    for key in a["loss"]:
+        assert torch.equal(a["loss"][key], b["loss"][key]), key
+    assert torch.equal(a["rng"]["torch"], b["rng"]["torch"])
+
+
+def test_two_worker_cli_run_writes_checkpoint_and_resumes(tmp_path):
+    run = tmp_path / "run"
+    args = ["train", *TINY_ENV, "--envs", "2", "--frames-per-batch", "2", "--init-random-frames", "2",
+            "--out", str(run), "--no-progress"]
+    assert main([*args, "--frames", "4"]) == 0
+    assert load_checkpoint(run / "checkpoint.pt")["counters"]["frames"] == 4
+    assert main([*args, "--frames", "8"]) == 0
+    state = load_checkpoint(run / "checkpoint.pt")
+    assert state["counters"] == {"frames": 8, "updates": 8}
+    assert "env" not in state  # parallel workers' episodes are not checkpointed
+    with open(run / "metrics.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert [int(r["frames"]) for r in rows] == [2, 4, 6, 8]
+    assert any((run / "tensorboard").iterdir())
+    assert Image.open(run / "training.png").size[0] > 500
+
+
+def test_reward_scale_is_the_same_update_as_scaled_rewards():
+    config = tiny(None, 10)
+
+    def one_update(rewards_times: float, reward_scale: float) -> list[torch.Tensor]:
+        torch.manual_seed(0)
+        actor, critic = make_sac_agent(config.env, config.network)
+        loss, _ = make_loss_module(actor, critic, config.optim)
+        optim_actor, optim_critic = make_optimizers(loss, config.optim)
+        n, side = 4, config.env.obs_size
+        state = {"pixels": torch.full((n, 5, side, side), 100, dtype=torch.uint8),
+                 "viewpoints": torch.zeros(n, 5, 3)}
+        sample = TensorDict({**state, "action": torch.zeros(n, 3), "next": TensorDict({
+            **state, "reward": torch.arange(n, dtype=torch.float32)[:, None] * rewards_times,
+            "done": torch.zeros(n, 1, dtype=torch.bool), "terminated": torch.zeros(n, 1, dtype=torch.bool)},
+            [n])}, [n])
+        sac_update(loss, optim_actor, optim_critic, sample, reward_scale)
+        return [p.detach().clone() for p in loss.qvalue_network_params.values(True, True)]
+
+    scaled = one_update(1.0, 0.1)
+    assert all(torch.equal(a, b) for a, b in zip(scaled, one_update(0.1, 1.0)))
+    assert not all(torch.equal(a, b) for a, b in zip(scaled, one_update(1.0, 1.0)))
+
+
+def test_resuming_with_other_settings_is_refused(tmp_path):
+    train(tiny(tmp_path / "run", 2))
+    with pytest.raises(CheckpointError, match="collector.seed: checkpoint 7, now 8"):
+        train(tiny(tmp_path / "run", 4, seed=8))
+    config = tiny(tmp_path / "run", 4)
+    other_bov = replace(config, env=replace(config.env, bov=replace(config.env.bov, match_cosine=0.6)))
+    with pytest.raises(CheckpointError, match="env.bov.match_cosine: checkpoint 0.8, now 0.6"):
+        train(other_bov)
+
+
+def test_corrupt_checkpoint_in_run_folder_is_a_clear_cli_error(tmp_path, capsys):
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "checkpoint.pt").write_bytes(b"not a checkpoint")
+    assert main(["train", *TINY_ENV, "--frames", "2", "--out", str(run), "--no-progress"]) == 2
+    assert "corrupt" in capsys.readouterr().err
+
+
+def test_unknown_scene_is_a_clear_cli_error(tmp_path, capsys):
+    out = str(tmp_path / "r")
+    args = ["train", "--scene", "test_building", "--scene", "no_such_scene", "--envs", "2", "--frames", "2",
+            "--frames-per-batch", "2", "--out", out, "--no-progress"]
+    assert main(args) == 2
+    assert "no_such_scene" in capsys.readouterr().err

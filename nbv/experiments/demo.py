@@ -12,7 +12,7 @@ from __future__ import annotations
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -23,41 +23,25 @@ from common.provenance import config_record, git_commit
 from nbv.bov.config import BoVConfig
 from nbv.bov.refine import Progress, RefineConfig, refine_dataset
 from nbv.experiments.paper_numbers import FULL_SCAN_VIEWS, SEC7_SUMMARY, TABLE2
-from nbv.recon.config import MetricsConfig, ReconstructionConfig
+from nbv.experiments.study import FullScanStudy
 from nbv.recon.heatmap import write_heatmap
 from nbv.recon.metrics import SurfaceMetrics, evaluate_surfaces
 from nbv.recon.tsdf import Reconstruction, reconstruct_dataset, save_reconstruction
 from nbv.viz.figures import contact_sheet, plot_trajectory
-from render.camera import UAVCamera
 from render.dataset import ViewDataset, read_dataset
-from render.scan import HemispherePlan
-from render.scan_cache import full_scan
-from render.settings import RenderSettings
-from scenes import DEFAULT_SCENE, load_scene
+from scenes.catalog import DEFAULT_SCENE
 
 
 @dataclass(frozen=True, kw_only=True)
-class DemoConfig:
+class DemoConfig(FullScanStudy):
     """Settings of `nbv demo`."""
 
     out: Path = Path("demo_out")
     """Folder for the datasets, reconstructions, figures and tables."""
     scene: str = DEFAULT_SCENE
-    """Built-in scene name, random:SEED, or a mesh path (z up)."""
-    camera: UAVCamera = UAVCamera()
-    """The camera of the scan."""
-    render: RenderSettings = RenderSettings()
-    """How views are rendered."""
-    plan: HemispherePlan = HemispherePlan()
-    """The full hemisphere scan (the defaults give the paper's 288 views)."""
+    """Built-in scene name, random:SEED, or a mesh path (with --up-axis)."""
     bov: BoVConfig = BoVConfig()
     """The Bag of Views of the refinement."""
-    recon: ReconstructionConfig = ReconstructionConfig()
-    """TSDF fusion of both view sets."""
-    metrics: MetricsConfig = MetricsConfig(n_points=200_000)
-    """How the reconstructions are compared."""
-    seed: int = 0
-    """Seed of the renders, the Bag of Views and the metric samples."""
     fresh: bool = False
     """Rescan even if the output folder already holds a full scan made with these settings."""
 
@@ -83,11 +67,10 @@ def run_demo(config: DemoConfig, progress: Progress | None = None) -> dict[str, 
     """
     out = Path(config.out)
     out.mkdir(parents=True, exist_ok=True)
-    scene = load_scene(config.scene)
+    scene = config.load(config.scene)
     clock = Stopwatch()
     with clock.stage("scan_s"):
-        full = full_scan(scene, config.camera, out / "full_scan", replace(config.render, seed=config.seed),
-                         config.render.variant, config.plan, config.fresh)
+        full = config.full_scan(scene, out / "full_scan", config.fresh)
     with clock.stage("refine_s"):
         refine = RefineConfig(dataset=full.root, out=out / "refined", bov=config.bov, seed=config.seed,
                               overwrite=True)
@@ -99,7 +82,7 @@ def run_demo(config: DemoConfig, progress: Progress | None = None) -> dict[str, 
         save_reconstruction(recon_refined, out / "recon_refined")
     gt = scene.target_mesh()
     with clock.stage("evaluate_s"):
-        metrics_config = replace(config.metrics, seed=config.seed)
+        metrics_config = config.seeded_metrics
         metrics = {
             "full": evaluate_surfaces(recon_full.mesh, {"gt": gt}, metrics_config),
             "refined": evaluate_surfaces(recon_refined.mesh, {"gt": gt, "reference": recon_full.mesh},

@@ -12,7 +12,7 @@ labelled columns.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -22,16 +22,11 @@ from nbv.bov.config import BoVRule
 from nbv.bov.refine import DatasetRun, Progress, kept_view_grid, load_views
 from nbv.bov.sweep import PAPER_RANGES, PAPER_WORDS, write_csv
 from nbv.experiments.paper_numbers import FULL_SCAN_VIEWS, TABLE2, TABLE2_RANGES, TABLE2_WORDS
-from nbv.recon.config import MetricsConfig, ReconstructionConfig
+from nbv.experiments.study import FullScanStudy
 from nbv.recon.heatmap import write_heatmap
 from nbv.recon.metrics import evaluate_surfaces
 from nbv.recon.tsdf import reconstruct_dataset
 from nbv.viz.figures import plot_table2
-from render.camera import UAVCamera
-from render.scan import HemispherePlan
-from render.scan_cache import full_scan
-from render.settings import RenderSettings
-from scenes import load_scene
 
 COLUMNS = {"ranges": "N", "words": "W", "views": "views", "paper_views": "paper views",
            "ref_hausdorff_cm": "Hausdorff ref", "paper_hausdorff_cm": "paper Hausdorff",
@@ -41,7 +36,7 @@ COLUMNS = {"ranges": "N", "words": "W", "views": "views", "paper_views": "paper 
 
 
 @dataclass(frozen=True, kw_only=True)
-class TablesConfig:
+class TablesConfig(FullScanStudy):
     """Settings of `nbv tables`."""
 
     out: Path = Path("paper_results")
@@ -52,20 +47,8 @@ class TablesConfig:
     """N values of the grid (size of the Bag of Views)."""
     words: tuple[int, ...] = PAPER_WORDS
     """W values of the grid (words per view range)."""
-    camera: UAVCamera = UAVCamera()
-    """The camera of the scans."""
-    render: RenderSettings = RenderSettings()
-    """How views are rendered."""
-    plan: HemispherePlan = HemispherePlan()
-    """The full hemisphere scan (the defaults give the paper's 288 views)."""
     rule: BoVRule = BoVRule()
     """The Bag of Views rule and features of every cell."""
-    recon: ReconstructionConfig = ReconstructionConfig()
-    """TSDF fusion of the full scan and of every refined set."""
-    metrics: MetricsConfig = MetricsConfig(n_points=200_000)
-    """How reconstructions are compared."""
-    seed: int = 0
-    """Seed of renders, Bag of Views and metric samples."""
 
 
 def paper_cell(scene: str, n: int, w: int) -> dict[str, Any]:
@@ -89,13 +72,12 @@ def measure_scene(name: str, config: TablesConfig, progress: Progress | None = N
     Writes the Fig. 6 heat maps of the grid's corner cells into `config.out/fig6`.
     `progress` is called once per row measured.
     """
-    scene = load_scene(name)
-    full = full_scan(scene, config.camera, settings=replace(config.render, seed=config.seed),
-                     variant=config.render.variant, plan=config.plan)
+    scene = config.load(name)
+    full = config.full_scan(scene)
     _, feats, azimuths = load_views(DatasetRun(dataset=full.root, seed=config.seed), config.rule)
     grid = kept_view_grid([f.descriptors for f in feats], azimuths, config.ranges, config.words, config.rule,
                           config.seed)
-    metrics = replace(config.metrics, seed=config.seed)
+    metrics = config.seeded_metrics
     reference = reconstruct_dataset(full, config.recon).mesh
     gt = scene.target_mesh()
     full_vs_gt = evaluate_surfaces(reference, {"gt": gt}, metrics)["gt"]

@@ -12,6 +12,8 @@ _EXPORTS = {
     "spherical_kmeans": "nbv.bov.kmeans",
     "refine_views": "nbv.bov.refine",
     "refine_dataset": "nbv.bov.refine",
+    "RefineConfig": "nbv.bov.refine",
+    "SweepConfig": "nbv.bov.sweep",
 }
 __all__ = sorted(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -16,6 +16,8 @@ _EXPORTS = {
     "SurfaceMetrics": "nbv.recon.metrics",
     "evaluate_surfaces": "nbv.recon.metrics",
     "write_heatmap": "nbv.recon.heatmap",
+    "EvaluateConfig": "nbv.recon.evaluate",
+    "ReconstructConfig": "nbv.recon.reconstruct",
 }
 __all__ = sorted(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -9,6 +9,9 @@ _EXPORTS = {
     "contact_sheet": "nbv.viz.figures",
     "plot_trajectory": "nbv.viz.figures",
     "plot_planner_comparison": "nbv.viz.figures",
+    "plot_table2": "nbv.viz.figures",
+    "plot_training": "nbv.viz.figures",
+    "PlotTrainingConfig": "nbv.viz.figures",
 }
 __all__ = sorted(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -2,13 +2,20 @@
 
 A file is written under a temporary name beside its destination (the name
 holds the process id, so two runs never share one) and renamed into place,
-so a reader sees the old file or the new one, never half of one.
+so a reader sees the old file or the new one, never half of one. A command's
+output folder is written the same way (`atomic_folder`), and the temporary
+folders of a run that died are cleaned up by the next run writing that folder.
 """
 
 from __future__ import annotations
 
+import ctypes
+import errno
 import json
 import os
+import re
+import shutil
+import tempfile
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -36,6 +43,159 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         tmp.replace(path)
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def current_umask() -> int:
+    """The process umask (read by setting it and putting it back)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def check_output_folder(out: Path, overwrite: bool, outputs: tuple[str, ...] | None = None) -> None:
+    """Fail early, naming the folder, if `out` cannot be written or would lose existing data.
+
+    `outputs`: the names the command writes into `out` (other entries are kept); None: the whole folder.
+    """
+    out = Path(out)
+    recover_stale(out)
+    if out.exists() and not out.is_dir():
+        raise FileExistsError(f"output {out} exists and is not a folder")
+    if outputs is None:
+        if out.is_dir() and any(out.iterdir()) and not overwrite:
+            raise FileExistsError(f"output folder {out} exists and is not empty (use --overwrite)")
+    elif not overwrite and (existing := [name for name in outputs if (out / name).exists()]):
+        raise FileExistsError(f"{out} already holds {', '.join(existing)} (use --overwrite)")
+    parent = out.parent
+    while not parent.exists():
+        parent = parent.parent
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise PermissionError(f"output folder {out} is not writable (no write access to {parent})")
+
+
+def check_separate(out: str | Path, source: str | Path, may_hold: bool = False) -> None:
+    """Refuse (ValueError naming `out`) an output folder that is or lies in the input folder `source`,
+    or holds it unless `may_hold` (when the output replaces only its own files)."""
+    out_path, src_path = Path(out).resolve(), Path(source).resolve()
+    if out_path == src_path or src_path in out_path.parents:
+        raise ValueError(f"out {out} must not be the input folder {source} or lie inside it")
+    if out_path in src_path.parents and not may_hold:
+        raise ValueError(f"out {out} holds the input folder {source}: replacing it would delete the input")
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def recover_stale(out: str | Path) -> None:
+    """Clean up after dead runs that wrote `out`: remove their `.NAME.tmp-PID-*` folders and their
+    `.NAME.old-PID` (the previous output moved aside for the swap), put back if `out` is missing."""
+    out = Path(out)
+    if not out.parent.is_dir():
+        return
+    pattern = re.compile(rf"\.{re.escape(out.name)}\.(tmp|old)-(\d+)(-.*)?")
+    for entry in sorted(out.parent.iterdir(), key=lambda p: p.name):
+        match = pattern.fullmatch(entry.name)
+        if match is None or _pid_alive(int(match[2])):
+            continue
+        if match[1] == "old" and not out.exists():
+            entry.rename(out)
+        elif entry.is_dir() and not entry.is_symlink():
+            shutil.rmtree(entry, ignore_errors=True)
+        else:
+            entry.unlink(missing_ok=True)
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two existing paths in one step (Linux `renameat2` RENAME_EXCHANGE); False where unsupported."""
+    renameat2 = getattr(ctypes.CDLL(None, use_errno=True), "renameat2", None)
+    if renameat2 is None:
+        return False
+    at_fdcwd, rename_exchange = -100, 2
+    if renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange) == 0:
+        return True
+    code = ctypes.get_errno()
+    if code in (errno.EINVAL, errno.ENOSYS, errno.EOPNOTSUPP, errno.EPERM):
+        return False
+    raise OSError(code, os.strerror(code), str(b))
+
+
+def replace_folder(src: Path, dst: Path) -> None:
+    """Move the finished folder `src` onto `dst`: in one exchange where the OS offers it, else the old `dst`
+    is moved aside, removed only once `src` is in place, and put back if the swap fails or is interrupted."""
+    if dst.is_dir() and not dst.is_symlink() and _exchange(src, dst):
+        shutil.rmtree(src, ignore_errors=True)  # src now holds the old output
+        return
+    old = dst.with_name(f".{dst.name}.old-{os.getpid()}") if dst.exists() else None
+    done = False
+    try:
+        if old is not None:
+            dst.rename(old)
+        src.rename(dst)
+        done = True
+    finally:
+        if old is not None and old.exists():
+            if done:
+                shutil.rmtree(old, ignore_errors=True)
+            elif not dst.exists():
+                old.rename(dst)
+
+
+def _carry(src: Path, dst: Path, skip: tuple[str, ...]) -> None:
+    """Hard-link (or copy) the entries of `src` not named in `skip` into the empty folder `dst`."""
+    for entry in src.iterdir():
+        if entry.name in skip:
+            continue
+        if entry.is_dir() and not entry.is_symlink():
+            shutil.copytree(entry, dst / entry.name, symlinks=True, copy_function=_link_or_copy)
+        else:
+            _link_or_copy(entry, dst / entry.name)
+
+
+def _link_or_copy(src: str | Path, dst: str | Path) -> None:
+    if Path(src).is_symlink():
+        os.symlink(os.readlink(src), dst)
+        return
+    try:
+        os.link(src, dst)
+    except OSError:
+        shutil.copy2(src, dst)
+
+
+@contextmanager
+def atomic_folder(out: str | Path, overwrite: bool = False,
+                  outputs: tuple[str, ...] | None = None) -> Iterator[Path]:
+    """A temporary folder beside `out` to write the output into; swapped onto `out` in one rename when
+    the block succeeds, removed (and `out` left as it was) when it fails or is interrupted.
+
+    `outputs`: the names the command writes (other entries of `out` are carried into the new folder);
+    None: the whole folder is the output. Refuses (FileExistsError) to replace output without `overwrite`.
+
+    Example:
+        >>> folder = Path(tempfile.mkdtemp())
+        >>> with atomic_folder(folder / "run") as tmp:
+        ...     _ = (tmp / "a.txt").write_text("hello")
+        >>> sorted(p.name for p in (folder / "run").iterdir()), sorted(p.name for p in folder.iterdir())
+        (['a.txt'], ['run'])
+    """
+    out = Path(out)
+    check_output_folder(out, overwrite, outputs)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-{os.getpid()}-", dir=out.parent))
+    try:
+        tmp.chmod(0o777 & ~current_umask())  # mkdtemp makes 0700; outputs are shared like any folder
+        if outputs is not None and out.is_dir():
+            _carry(out, tmp, outputs)
+        yield tmp
+        replace_folder(tmp, out)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
 def write_text(path: str | Path, text: str) -> Path:

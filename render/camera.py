@@ -15,6 +15,8 @@ import numpy as np
 
 SENSOR_WIDTH_MM = 36.0
 SENSOR_HEIGHT_MM = 24.0
+FOCAL_RANGE_MM = (1.0, 10_000.0)
+"""Focal lengths accepted: a 1 mm lens sees 172 degrees across, a 10 m one 0.2 degrees."""
 
 
 @dataclass(frozen=True)
@@ -26,7 +28,7 @@ class UAVCamera:
     height: int = 240
     """Image height in pixels."""
     focal_mm: float = 35.0
-    """Focal length in millimetres on the 36 mm wide sensor."""
+    """Focal length in millimetres on the 36 mm wide sensor, in [1, 10000]."""
     near_m: float = 0.05
     """Nearest depth reported, metres."""
     far_m: float = 10.0
@@ -41,6 +43,9 @@ class UAVCamera:
             value = getattr(self, name)
             if not math.isfinite(value) or value <= 0:
                 raise ValueError(f"camera {name} must be positive and finite, got {value!r}")
+        if not FOCAL_RANGE_MM[0] <= self.focal_mm <= FOCAL_RANGE_MM[1]:
+            raise ValueError(f"camera focal_mm must lie in [{FOCAL_RANGE_MM[0]:g}, {FOCAL_RANGE_MM[1]:g}], "
+                             f"got {self.focal_mm!r}")
         if self.near_m >= self.far_m:
             raise ValueError(f"camera near_m ({self.near_m}) must be below far_m ({self.far_m})")
 

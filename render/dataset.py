@@ -10,11 +10,8 @@ beside the target, renamed into place only when complete.
 
 from __future__ import annotations
 
-import json
-import os
-import shutil
-import tempfile
 from collections.abc import Iterator
+from contextlib import ExitStack
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -23,17 +20,28 @@ import cv2
 import numpy as np
 from PIL import Image
 
-from common.io import write_json
+from common.io import atomic_folder, check_output_folder, write_json
+from common.io import current_umask as current_umask  # re-exported: dataset folders use the umask
+from common.io import replace_folder as replace_folder  # re-exported for render.colmap
 from render.camera import UAVCamera
+from render.dataset_read import (
+    DEPTH_SCALE,
+    FORMAT_VERSION,
+    DatasetError,
+    contained_file,
+    object_field,
+    read_camera,
+    read_center,
+    read_document,
+    read_png,
+    read_pose,
+    read_viewpoint,
+    typed_field,
+)
 from render.viewpoint import Viewpoint, opencv_to_opengl, validate_pose
 
-DEPTH_SCALE = 0.001
-"""Metres per unit of the uint16 depth PNGs."""
-FORMAT_VERSION = 1
-
-
-class DatasetError(ValueError):
-    """A dataset on disk is missing, corrupt or inconsistent; the message names the file and field."""
+APPLIED_TRANSFORM = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]]
+"""nerfstudio's `applied_transform`, written explicitly as the identity (poses are stored as they are)."""
 
 
 @dataclass(frozen=True)
@@ -71,7 +79,7 @@ class ViewDataset:
     @property
     def center(self) -> np.ndarray:
         """The scene centre the viewpoints are relative to."""
-        return np.asarray(self.meta.get("center", [0.0, 0.0, 0.0]), dtype=np.float64)
+        return read_center(self.meta, self.root / "transforms.json")
 
     def poses(self) -> np.ndarray:
         """(N, 4, 4) camera-to-world matrices, OpenCV convention."""
@@ -79,31 +87,12 @@ class ViewDataset:
 
     def rgb(self, index: int) -> np.ndarray:
         """Frame `index` as H x W x 3 uint8 sRGB."""
-        path = self.frames[index].rgb_path
-        try:
-            with Image.open(path) as img:
-                rgb = np.asarray(img.convert("RGB"))
-        except (OSError, ValueError) as err:
-            raise DatasetError(f"{path}: cannot read image: {err}") from err
-        self._check_shape(path, rgb.shape[:2])
-        return rgb
+        return read_png(self.frames[index].rgb_path, self.camera.width, self.camera.height, depth=False)
 
     def depth(self, index: int) -> np.ndarray:
         """Frame `index` as H x W float32 z-depth in metres (0: no hit)."""
-        path = self.frames[index].depth_path
-        raw = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-        if raw is None:
-            raise DatasetError(f"{path}: cannot read depth image")
-        if raw.dtype != np.uint16 or raw.ndim != 2:
-            raise DatasetError(f"{path}: depth must be single-channel uint16, got {raw.dtype} {raw.shape}")
-        self._check_shape(path, raw.shape)
+        raw = read_png(self.frames[index].depth_path, self.camera.width, self.camera.height, depth=True)
         return raw.astype(np.float32) * np.float32(DEPTH_SCALE)
-
-    def _check_shape(self, path: Path, shape: tuple[int, ...]) -> None:
-        expected = (self.camera.height, self.camera.width)
-        if tuple(shape) != expected:
-            raise DatasetError(f"{path}: image is {shape[1]}x{shape[0]}, transforms.json says "
-                               f"w={expected[1]}, h={expected[0]}")
 
 
 def depth_to_png(depth: np.ndarray) -> np.ndarray:
@@ -118,6 +107,7 @@ class DatasetWriter:
 
     Leaving the block normally renames the temporary folder onto `out`; an
     exception (or Ctrl-C) removes it, and whatever stood at `out` before is kept.
+    Extra files written into `folder` inside the block are part of the same swap.
     """
 
     def __init__(self, out: str | Path, camera: UAVCamera, meta: dict[str, Any],
@@ -128,11 +118,17 @@ class DatasetWriter:
         self.overwrite = overwrite
         self._frames: list[dict[str, Any]] = []
         self._tmp: Path | None = None
+        self._stack = ExitStack()
         check_output_folder(self.out, overwrite)
 
+    @property
+    def folder(self) -> Path:
+        """The temporary folder being written (inside the with-block)."""
+        assert self._tmp is not None, "DatasetWriter.folder used outside its with-block"
+        return self._tmp
+
     def __enter__(self) -> DatasetWriter:
-        self.out.parent.mkdir(parents=True, exist_ok=True)
-        self._tmp = Path(tempfile.mkdtemp(prefix=f".{self.out.name}.tmp-", dir=self.out.parent))
+        self._tmp = self._stack.enter_context(atomic_folder(self.out, self.overwrite))
         (self._tmp / "images").mkdir()
         (self._tmp / "depth").mkdir()
         return self
@@ -163,14 +159,10 @@ class DatasetWriter:
     def __exit__(self, exc_type, exc, tb) -> None:
         assert self._tmp is not None
         if exc_type is not None:
-            shutil.rmtree(self._tmp, ignore_errors=True)
+            self._stack.__exit__(exc_type, exc, tb)
             return
-        try:
+        with self._stack:
             write_json(self._tmp / "transforms.json", transforms_json(self.camera, self._frames, self.meta))
-            replace_folder(self._tmp, self.out)
-        except BaseException:
-            shutil.rmtree(self._tmp, ignore_errors=True)
-            raise
 
 
 def transforms_json(camera: UAVCamera, frames: list[dict[str, Any]], meta: dict[str, Any]) -> dict:
@@ -183,103 +175,52 @@ def transforms_json(camera: UAVCamera, frames: list[dict[str, Any]], meta: dict[
         "w": camera.width, "h": camera.height,
         "k1": 0.0, "k2": 0.0, "p1": 0.0, "p2": 0.0,
         "depth_unit_scale_factor": DEPTH_SCALE,
+        "applied_transform": APPLIED_TRANSFORM,
         "frames": frames,
         "nbv": {"version": FORMAT_VERSION, "focal_mm": camera.focal_mm, "near_m": camera.near_m,
                 "far_m": camera.far_m, **meta},
     }
 
 
-def check_output_folder(out: Path, overwrite: bool) -> None:
-    """Fail early, naming the folder, if `out` cannot be written or would lose existing data."""
-    if out.exists() and not out.is_dir():
-        raise FileExistsError(f"output {out} exists and is not a folder")
-    if out.is_dir() and any(out.iterdir()) and not overwrite:
-        raise FileExistsError(f"output folder {out} exists and is not empty (use --overwrite)")
-    parent = out.parent
-    while not parent.exists():
-        parent = parent.parent
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise PermissionError(f"output folder {out} is not writable (no write access to {parent})")
-
-
-def replace_folder(src: Path, dst: Path) -> None:
-    """Move the finished folder `src` onto `dst`, removing the old `dst` only afterwards."""
-    old = None
-    if dst.exists():
-        old = dst.with_name(f".{dst.name}.old-{os.getpid()}")
-        dst.rename(old)
-    src.rename(dst)
-    if old is not None:
-        shutil.rmtree(old, ignore_errors=True)
-
-
 def read_dataset(path: str | Path) -> ViewDataset:
     """Read and validate a dataset folder; errors name the file and the field at fault."""
     root = Path(path)
     doc_path = root / "transforms.json"
-    if not doc_path.is_file():
-        raise DatasetError(f"{doc_path}: not found (is {root} a view dataset?)")
-    try:
-        doc = json.loads(doc_path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as err:
-        raise DatasetError(f"{doc_path}: corrupt JSON: {err}") from err
-    if not isinstance(doc, dict):
-        raise DatasetError(f"{doc_path}: top level must be an object")
-    nbv = doc.get("nbv", {})
-    camera = _read_camera(doc, nbv, doc_path)
-    raw_frames = _field(doc, "frames", list, doc_path)
-    frames = tuple(_read_frame(root, i, f, doc_path) for i, f in enumerate(raw_frames))
+    doc = read_document(doc_path)
+    _check_applied_transform(doc, doc_path)
+    nbv = object_field(doc, "nbv", doc_path)
+    camera = read_camera(doc, nbv, doc_path)
+    center = read_center(nbv, doc_path)
+    raw_frames = typed_field(doc, "frames", list, doc_path)
+    frames = tuple(_read_frame(root, i, f, center, doc_path) for i, f in enumerate(raw_frames))
     return ViewDataset(root, camera, frames, dict(nbv))
 
 
-def _field(obj: dict, key: str, kind: type | tuple[type, ...], where: Path, prefix: str = "") -> Any:
-    if key not in obj:
-        raise DatasetError(f"{where}: field {prefix}{key} is missing")
-    value = obj[key]
-    if not isinstance(value, kind) or isinstance(value, bool):
-        raise DatasetError(f"{where}: field {prefix}{key} has the wrong type ({type(value).__name__})")
-    return value
-
-
-def _read_camera(doc: dict, nbv: dict, where: Path) -> UAVCamera:
-    number = (int, float)
-    w, h = _field(doc, "w", int, where), _field(doc, "h", int, where)
-    fl_x = _field(doc, "fl_x", number, where)
-    if not np.isclose(_field(doc, "fl_y", number, where), fl_x, rtol=1e-6):
-        raise DatasetError(f"{where}: fields fl_x and fl_y differ; the UAV camera has square pixels")
-    for key, size in (("cx", w), ("cy", h)):
-        if not np.isclose(_field(doc, key, number, where), size / 2.0, atol=1e-3):
-            raise DatasetError(f"{where}: field {key} is off-centre; the UAV camera is centred")
+def _check_applied_transform(doc: dict, where: Path) -> None:
+    """Accept an absent (files written before it) or identity 3x4 `applied_transform`; refuse others."""
+    if "applied_transform" not in doc:
+        return
     try:
-        focal_mm = float(nbv.get("focal_mm", fl_x * 36.0 / w)) if w > 0 else float("nan")
-        return UAVCamera(w, h, focal_mm, float(nbv.get("near_m", 0.05)), float(nbv.get("far_m", 10.0)))
-    except (TypeError, ValueError) as err:
-        raise DatasetError(f"{where}: camera fields: {err}") from err
+        matrix = np.asarray(doc["applied_transform"], dtype=np.float64)
+    except (TypeError, ValueError, OverflowError):
+        matrix = None
+    if matrix is None or matrix.shape != (3, 4) or not np.allclose(matrix, APPLIED_TRANSFORM, atol=1e-9):
+        raise DatasetError(f"{where}: field applied_transform must be the 3x4 identity (poses are read as "
+                           f"stored), got {doc['applied_transform']!r}")
 
 
-def _read_frame(root: Path, i: int, frame: Any, where: Path) -> Frame:
+def _read_frame(root: Path, i: int, frame: Any, center: np.ndarray, where: Path) -> Frame:
     prefix = f"frames[{i}]."
     if not isinstance(frame, dict):
         raise DatasetError(f"{where}: frames[{i}] must be an object")
-    paths = []
-    for key in ("file_path", "depth_file_path"):
-        p = root / _field(frame, key, str, where, prefix)
-        if not p.is_file():
-            raise DatasetError(f"{where}: {prefix}{key} names a missing file {p}")
-        paths.append(p)
-    try:
-        matrix = np.asarray(_field(frame, "transform_matrix", list, where, prefix), dtype=np.float64)
-        c2w = validate_pose(opencv_to_opengl(matrix), f"{prefix}transform_matrix")
-    except ValueError as err:
-        raise DatasetError(f"{where}: {err}") from err
-    meta = frame.get("nbv", {})
-    view = None
-    if "viewpoint" in meta:
-        try:
-            view = Viewpoint(*map(float, meta["viewpoint"]))
-        except (TypeError, ValueError) as err:
-            raise DatasetError(f"{where}: {prefix}nbv.viewpoint: {err}") from err
-    return Frame(paths[0], paths[1], c2w, view, dict(meta))
+    rgb, depth = (contained_file(root, typed_field(frame, key, str, where, prefix), where, prefix + key)
+                  for key in ("file_path", "depth_file_path"))
+    c2w = read_pose(frame, where, prefix)
+    meta = object_field(frame, "nbv", where, prefix)
+    source = meta.get("source_index", 0)
+    if isinstance(source, bool) or not isinstance(source, int) or source < 0:
+        raise DatasetError(f"{where}: field {prefix}nbv.source_index must be a non-negative integer")
+    return Frame(rgb, depth, c2w, read_viewpoint(meta, c2w, center, where, prefix), dict(meta))
 
 
 def iter_views(dataset: ViewDataset) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]:
@@ -289,10 +230,14 @@ def iter_views(dataset: ViewDataset) -> Iterator[tuple[np.ndarray, np.ndarray, n
 
 
 def write_subset(dataset: ViewDataset, indices: list[int], out: str | Path,
-                 meta: dict[str, Any], overwrite: bool = False) -> None:
-    """Write the frames `indices` of `dataset` as a new dataset (frames record `source_index`)."""
+                 meta: dict[str, Any], overwrite: bool = False, extra: dict[str, Any] | None = None) -> None:
+    """Write the frames `indices` of `dataset` as a new dataset (frames record `source_index`).
+
+    `extra`: JSON documents by file name, written into the dataset folder in the same atomic swap."""
     merged = {**dataset.meta, **meta}
     with DatasetWriter(out, dataset.camera, merged, overwrite) as writer:
+        for name, doc in (extra or {}).items():
+            write_json(writer.folder / name, doc)
         for i in indices:
             frame = dataset.frames[i]
             writer.add(dataset.rgb(i), dataset.depth(i), frame.c2w, frame.viewpoint,

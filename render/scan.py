@@ -25,6 +25,20 @@ from render.settings import RenderSettings
 from render.viewpoint import TWO_PI, Viewpoint
 from scenes.spec import SceneSpec
 
+TARGET_REACH_M = 1.0
+"""Cameras stay at least this far from the scene centre: a normalised target (largest side 1 m) lies
+within 0.9 m of it (half its diagonal), so a closer camera may sit inside the building."""
+
+
+def check_camera_distance(name: str, radius: float, camera: UAVCamera) -> None:
+    """Refuse (ValueError naming `name`) a camera distance inside the target's reach, or too far for the
+    camera's far plane to reach the whole target."""
+    high = camera.far_m - TARGET_REACH_M
+    if not (math.isfinite(radius) and TARGET_REACH_M <= radius <= high):
+        raise ValueError(f"{name} must lie in [{TARGET_REACH_M:g}, {high:g}] m (outside the normalised "
+                         f"target, whose half-diagonal is under 0.9 m, and within far_m {camera.far_m:g} m "
+                         f"of all of it), got {radius}")
+
 
 @dataclass(frozen=True)
 class HemispherePlan:
@@ -127,7 +141,8 @@ class ScanConfig:
     plan: Literal["hemisphere", "circle"] = "hemisphere"
     """Scan plan: full-coverage hemisphere (paper Sec. V-B) or one circle."""
     radius: float = 2.0
-    """Camera distance from the scene centre, metres."""
+    """Camera distance from the scene centre, metres; at least 1 (outside the normalised target) and at
+    most far_m - 1."""
     end_overlap: float = 0.86
     """Overlap of consecutive images along a ring (hemisphere; circle when --views is not given)."""
     side_overlap: float = 0.8
@@ -140,6 +155,9 @@ class ScanConfig:
     """Base seed of the per-view render seeds."""
     overwrite: bool = False
     """Replace an existing non-empty output folder (only once the new scan is complete)."""
+
+    def __post_init__(self) -> None:
+        check_camera_distance("radius", self.radius, self.camera)
 
     def viewpoints(self) -> list[Viewpoint]:
         """The viewpoints the plan asks for."""

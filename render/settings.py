@@ -9,13 +9,16 @@ from tyro.conf import Suppress
 
 from render.variant import Variant
 
+MAX_SPP = 65_536
+"""Most samples per pixel (Mitsuba's samplers refuse counts near 2^32; 64k is far past converged)."""
+
 
 @dataclass(frozen=True)
 class RenderSettings:
     """How RGB images are rendered (depth always uses one exact ray per pixel)."""
 
     spp: int = 16
-    """Samples per pixel of the RGB pass."""
+    """Samples per pixel of the RGB pass, in [1, 65536]."""
     max_depth: int = 4
     """Longest light path (path integrator): 2 = direct light only."""
     integrator: Literal["path", "direct"] = "path"
@@ -27,8 +30,8 @@ class RenderSettings:
     own --seed, so it is no flag of its own."""
 
     def __post_init__(self) -> None:
-        if self.spp < 1:
-            raise ValueError(f"render spp must be >= 1, got {self.spp}")
+        if not 1 <= self.spp <= MAX_SPP:
+            raise ValueError(f"render spp must lie in [1, {MAX_SPP}], got {self.spp}")
         if self.max_depth < 1 and self.max_depth != -1:
             raise ValueError(f"render max_depth must be >= 1 (or -1), got {self.max_depth}")
         if self.integrator not in ("path", "direct"):

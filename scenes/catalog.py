@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from common.io import atomic_path
+from common.io import atomic_folder, check_output_folder
 from scenes.spec import SceneSpec
 
 if TYPE_CHECKING:
@@ -80,12 +80,11 @@ class ExportConfig(SceneSpec):
 
 
 def export_scene(config: ExportConfig) -> Path:
-    """Write the normalised target mesh (exactly as rendered, no ground) to `out/mesh.ply`, atomically."""
-    path = Path(config.out) / "mesh.ply"
-    if path.exists() and not config.overwrite:
-        raise FileExistsError(f"{path} already exists (use --overwrite)")
+    """Write the normalised target mesh (exactly as rendered, no ground) to `out/mesh.ply`, atomically
+    (other files in `out` are kept)."""
+    out = Path(config.out)
+    check_output_folder(out, config.overwrite, ("mesh.ply",))
     mesh = config.load().target_mesh()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        mesh.export(tmp, file_type="ply")
-    return path
+    with atomic_folder(out, config.overwrite, ("mesh.ply",)) as folder:
+        mesh.export(folder / "mesh.ply", file_type="ply")
+    return out / "mesh.ply"

@@ -1,12 +1,14 @@
-"""Bring-your-own targets: mesh files through trimesh, Mitsuba XML scenes as they are.
+"""Bring-your-own targets: mesh files through trimesh, Mitsuba XML scenes as they are (trusted like code).
 
 OBJ (with MTL and textures), PLY, GLB / glTF, DAE (pycollada), STL and OFF are
 read with trimesh, one `Part` per textured sub-mesh, keeping each material's
 base colour and texture. A sub-mesh without a texture gets a procedural one
 projected by planar UVs. The result is normalised (docs/conventions.md) after
-turning `up_axis` to z, and stands on a textured ground. Arrays are checked
-before use: NaN vertices, meshes without faces and out-of-range face indices
-raise a ValueError naming the file and the fault.
+turning `up_axis` to z, over the vertices faces use (unreferenced ones are
+dropped), and stands on a textured ground. Arrays are checked before use: NaN
+vertices, meshes without faces, out-of-range face indices, corrupt textures and
+a target of zero or overflowing size raise a ValueError naming the file and the
+fault. A Mitsuba XML file is loaded once on load, so its errors name it too.
 """
 
 from __future__ import annotations
@@ -51,13 +53,17 @@ def load_file_scene(path: str | Path, up_axis: str = "z", ground: bool = True) -
         raise FileNotFoundError(f"scene file not found: {path}")
     suffix = path.suffix.lower()
     if suffix == XML_SUFFIX:
+        _check_mitsuba_xml(path)
         return Scene(name=str(path), parts=(), mitsuba_xml=path.resolve())
     if suffix not in MESH_SUFFIXES:
         raise ValueError(
             f"{path}: unsupported file type {suffix!r}; use one of {', '.join(MESH_SUFFIXES + (XML_SUFFIX,))}"
         )
     raw = _read_parts(path)
-    parts = list(normalise_parts(raw, up_axis))
+    try:
+        parts = list(normalise_parts(raw, up_axis))
+    except ValueError as err:
+        raise ValueError(f"{path}: {err}") from err
     parts = [_with_procedural_texture(p) if p.uv is None else p for p in parts]
     if ground:
         parts.append(make_ground(Finish("grass"), 0, half_m=3.0, tile_m=0.5))
@@ -75,19 +81,27 @@ def _read_parts(path: Path) -> list[Part]:
         geometry = loaded.geometry[geometry_name]
         if not isinstance(geometry, trimesh.Trimesh):
             continue
-        vertices = np.asarray(geometry.vertices, dtype=np.float64)
-        faces = np.asarray(geometry.faces, dtype=np.int64).reshape(-1, 3)
         name = f"{len(parts):03d}_{geometry_name}"
         try:
-            validate_arrays(name, vertices, faces, None)
+            parts.append(_part(geometry, transform, name))
         except ValueError as err:
             raise ValueError(f"{path}: {err}") from err
-        vertices = trimesh.transformations.transform_points(vertices, transform)
-        material, uv = _material(geometry, name)
-        parts.append(Part(name, vertices, faces, material, uv))
     if not parts:
         raise ValueError(f"{path}: the file holds no triangle mesh with faces")
     return parts
+
+
+def _part(geometry: trimesh.Trimesh, transform: np.ndarray, name: str) -> Part:
+    """One checked `Part`, placed by its node transform, keeping only the vertices its faces use."""
+    vertices = np.asarray(geometry.vertices, dtype=np.float64)
+    faces = np.asarray(geometry.faces, dtype=np.int64).reshape(-1, 3)
+    validate_arrays(name, vertices, faces, None)
+    with np.errstate(over="ignore", invalid="ignore"):
+        vertices = trimesh.transformations.transform_points(vertices, transform)
+    material, uv = _material(geometry, name)
+    used, faces = np.unique(faces, return_inverse=True)
+    faces = faces.reshape(-1, 3)
+    return Part(name, vertices[used], faces, material, None if uv is None else uv[used])
 
 
 def _material(mesh: trimesh.Trimesh, name: str) -> tuple[Material, np.ndarray | None]:
@@ -100,17 +114,22 @@ def _material(mesh: trimesh.Trimesh, name: str) -> tuple[Material, np.ndarray | 
         color = tuple(float(c) / 255.0 for c in np.asarray(simple.diffuse)[:3])
         image = getattr(simple, "image", None)
         uv = None if visual.uv is None else np.asarray(visual.uv, dtype=np.float64)
-        if image is not None and uv is not None and len(uv) == len(mesh.vertices):
+        if image is not None and uv is not None and uv.shape == (len(mesh.vertices), 2):
+            if not np.all(np.isfinite(uv)):
+                raise ValueError(f"part {name!r}: texture coordinates contain NaN or infinite values")
             flipped = np.stack([uv[:, 0], 1.0 - uv[:, 1]], axis=1)
-            return Material(name, color, _save_texture(image), None), flipped
+            return Material(name, color, _save_texture(image, name), None), flipped
         return Material(name, color), None
     return Material(name), None
 
 
-def _save_texture(image: Image.Image) -> Path:
+def _save_texture(image: Image.Image, name: str) -> Path:
     """Write a mesh's texture to the cache as an sRGB PNG named by its content hash."""
     buffer = io.BytesIO()
-    image.convert("RGB").save(buffer, format="PNG")
+    try:
+        image.convert("RGB").save(buffer, format="PNG")
+    except Exception as err:  # PIL decodes lazily here and raises many types for corrupt data
+        raise ValueError(f"part {name!r}: cannot decode its texture ({type(err).__name__}: {err})") from err
     data = buffer.getvalue()
     path = cache_dir() / "mesh_textures" / f"{hashlib.sha1(data).hexdigest()}.png"
     if not path.exists():
@@ -118,6 +137,18 @@ def _save_texture(image: Image.Image) -> Path:
         with atomic_path(path) as tmp:
             tmp.write_bytes(data)
     return path
+
+
+def _check_mitsuba_xml(path: Path) -> None:
+    """Load a Mitsuba scene file once, so that its errors name the file (the XML is trusted like code)."""
+    import mitsuba as mi
+
+    try:
+        if mi.variant() is None:
+            mi.set_variant("scalar_rgb")
+        mi.load_file(str(path))
+    except Exception as err:  # Mitsuba raises RuntimeError, and others for odd files
+        raise ValueError(f"{path}: cannot load Mitsuba scene ({type(err).__name__}: {err})") from err
 
 
 def _with_procedural_texture(part: Part) -> Part:

@@ -30,7 +30,7 @@ def normalise_parts(parts: list[Part], up_axis: str = "z") -> tuple[Part, ...]:
     """Parts rotated to z up, scaled and moved so the target stands normalised.
 
     Raises:
-        ValueError: no target part, or a target of zero size.
+        ValueError: no target part, or a target of zero or overflowing size.
     """
     verts = [up_to_z(p.vertices, up_axis) for p in parts]
     targets = [v for v, p in zip(verts, parts) if p.target]
@@ -38,11 +38,18 @@ def normalise_parts(parts: list[Part], up_axis: str = "z") -> tuple[Part, ...]:
         raise ValueError("cannot normalise: the scene has no target geometry")
     lo = np.min([v.min(axis=0) for v in targets], axis=0)
     hi = np.max([v.max(axis=0) for v in targets], axis=0)
-    extent = float(np.max(hi - lo))
+    with np.errstate(over="ignore", invalid="ignore"):
+        extent = float(np.max(hi - lo))
     if not extent > 0:
         raise ValueError("cannot normalise: the target mesh has zero size (all vertices coincide)")
-    offset = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2]])
-    return tuple(replace(p, vertices=(v - offset) / extent) for v, p in zip(verts, parts))
+    if not np.isfinite(extent):
+        raise ValueError(f"cannot normalise: the target mesh's extent overflows (from {lo} to {hi})")
+    offset = np.array([lo[0] / 2 + hi[0] / 2, lo[1] / 2 + hi[1] / 2, lo[2]])
+    with np.errstate(over="ignore", invalid="ignore"):
+        moved = [(v - offset) / extent for v in verts]
+    if not all(np.all(np.isfinite(v)) for v in moved):
+        raise ValueError("cannot normalise: a part lies too far from the target (coordinates overflow)")
+    return tuple(replace(p, vertices=v) for v, p in zip(moved, parts))
 
 
 def make_ground(

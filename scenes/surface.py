@@ -41,8 +41,8 @@ def planar_uv(corners: np.ndarray, tile_m: float, rotate: bool = False) -> np.nd
     """(F, 3, 2) texture coordinates of (F, 3, 3) triangle corners, one tile per `tile_m` metres."""
     normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     normal /= np.linalg.norm(normal, axis=1, keepdims=True) + 1e-300
-    flat = np.abs(normal[:, 2]) > 0.9
     u = np.cross(np.array([0.0, 0.0, 1.0]), normal)
+    flat = (np.abs(normal[:, 2]) > 0.9) | ~(np.linalg.norm(u, axis=1) > 1e-9)  # or zero-area faces
     u[flat] = (1.0, 0.0, 0.0)
     u /= np.linalg.norm(u, axis=1, keepdims=True)
     v = np.cross(normal, u)

@@ -17,6 +17,10 @@ if TYPE_CHECKING:
 
 DEFAULT_MATCH_COSINE = 0.8
 """c of d = 1 - cos / c; measured on our SIFT scans (docs/bov.md §4). 0.5 is the paper's Eq. 1."""
+MAX_RANGES = 360
+"""Most azimuth ranges N (one per degree); more only allocates empty vocabularies."""
+MAX_WORDS = 10_000
+"""Most words W per range (a view has at most a few thousand descriptors)."""
 
 
 @dataclass(frozen=True)
@@ -56,6 +60,13 @@ class BoVRule:
                           kmeans_iters=self.kmeans_iters, match_cosine=self.match_cosine)
 
 
+def check_size(ranges: int, words: int) -> None:
+    """Refuse (ValueError naming the field) N outside [1, MAX_RANGES] or W outside [1, MAX_WORDS]."""
+    if not (1 <= ranges <= MAX_RANGES and 1 <= words <= MAX_WORDS):
+        raise ValueError(f"ranges and words must be >= 1 and at most {MAX_RANGES} and {MAX_WORDS}, "
+                         f"got N={ranges}, W={words}")
+
+
 @dataclass(frozen=True)
 class BoVConfig(BoVRule):
     """A Bag of Views of a given size under the rule (paper Table 2's N and W)."""
@@ -67,8 +78,7 @@ class BoVConfig(BoVRule):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        if self.ranges < 1 or self.words < 1:
-            raise ValueError(f"ranges and words must be >= 1, got N={self.ranges}, W={self.words}")
+        check_size(self.ranges, self.words)
 
     def bag(self, seed: int = 0, device: str = "cpu") -> BagOfViews:
         """An empty Bag of Views of this size."""

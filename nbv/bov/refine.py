@@ -10,6 +10,7 @@ the dataset's centre. Features come from the on-disk cache, so a sweep over
 from __future__ import annotations
 
 import math
+import re
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -20,7 +21,7 @@ import numpy as np
 import torch
 from tyro.conf import Positional, arg
 
-from common.io import write_json
+from common.io import check_separate
 from common.provenance import config_record
 from nbv.bov.bag import DEFAULT_MATCH_COSINE, BagOfViews
 from nbv.bov.config import BoVConfig, BoVRule
@@ -49,6 +50,14 @@ class DatasetRun:
     cache_dir: Path | None = None
     """Feature cache folder (default: $NBV_CACHE_DIR/features or ~/.cache/nbv/features)."""
 
+    def __post_init__(self) -> None:
+        if self.seed < 0:
+            raise ValueError(f"seed must be >= 0, got {self.seed}")
+        if self.threads < 0:
+            raise ValueError(f"threads must be >= 0 (0: torch's default), got {self.threads}")
+        if not re.fullmatch(r"cpu|cuda(:\d+)?", self.device):
+            raise ValueError(f"device must be cpu, cuda or cuda:N, got {self.device!r}")
+
     def settings(self, rule: BoVRule) -> dict[str, Any]:
         """The rule and this run's settings as one flat record (`settings` in refine.json, sweep.json)."""
         return {**config_record(rule), "seed": self.seed, "device": self.device,
@@ -65,6 +74,10 @@ class RefineConfig(DatasetRun):
     """The Bag of Views: N, W and the rule."""
     overwrite: bool = False
     """Replace the output folder if it is not empty."""
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_separate(self.out, self.dataset)
 
 
 @dataclass(frozen=True)
@@ -133,6 +146,8 @@ def refine_with(rule: BoVRule, descriptors: Sequence[torch.Tensor], azimuths: Se
 def load_views(run: DatasetRun, rule: BoVRule, progress: Progress | None = None
                ) -> tuple[ViewDataset, list[Features], np.ndarray]:
     """Read the run's dataset and its (cached) features and azimuths; fail clearly on an empty dataset."""
+    if run.device.startswith("cuda") and int(run.device.partition(":")[2] or 0) >= torch.cuda.device_count():
+        raise ValueError(f"device {run.device!r}: torch sees {torch.cuda.device_count()} CUDA GPU(s) here")
     dataset = read_dataset(run.dataset)
     if run.threads > 0:
         torch.set_num_threads(run.threads)
@@ -164,8 +179,7 @@ def refine_dataset(config: RefineConfig, progress: Progress | None = None) -> di
                "seconds": round(time.perf_counter() - start, 3),
                "note": "scores: null is +inf (first view of an empty range); a view is kept iff score > 0"}
     write_subset(dataset, result.kept, out, {"refine": {"source": str(config.dataset), **settings}},
-                 config.overwrite)
-    write_json(out / "refine.json", summary)
+                 config.overwrite, extra={"refine.json": summary})
     return summary
 
 

@@ -13,14 +13,18 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from common.io import atomic_path, markdown_table, write_json, write_text
-from nbv.bov.config import BoVRule
+from common.io import atomic_folder, atomic_path, markdown_table, write_json, write_text
+from nbv.bov.config import BoVRule, check_size
 from nbv.bov.refine import DatasetRun, Progress, RefineResult, kept_view_grid, load_views
 
 PAPER_RANGES = (5, 7, 9, 11)
 """The N values of the paper's Table 2."""
 PAPER_WORDS = (10, 20, 30)
 """The W values of the paper's Table 2."""
+
+
+OUTPUTS = ("sweep.csv", "sweep.md", "sweep.json")
+"""Files `nbv refine-sweep` writes into its output folder (other files there are kept)."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -37,10 +41,12 @@ class SweepConfig(DatasetRun):
     """The Bag of Views rule and features of every cell."""
 
     def __post_init__(self) -> None:
-        for name in ("ranges", "words"):
-            values = getattr(self, name)
-            if not values or any(v < 1 for v in values):
-                raise ValueError(f"--{name} values must be >= 1 (at least one), got {values}")
+        super().__post_init__()
+        if not self.ranges or not self.words:
+            raise ValueError(f"ranges and words need a value each, got {self.ranges}, {self.words}")
+        for n in self.ranges:
+            for w in self.words:
+                check_size(n, w)
 
 
 def sweep(config: SweepConfig, progress: Progress | None = None,
@@ -54,15 +60,14 @@ def sweep(config: SweepConfig, progress: Progress | None = None,
     grid = kept_view_grid([f.descriptors for f in feats], azimuths, config.ranges, config.words,
                           config.rule, config.seed, config.device, grid_progress)
     rows = grid_rows(grid, len(dataset))
-    out = Path(config.out)
-    out.mkdir(parents=True, exist_ok=True)
-    write_csv(out / "sweep.csv", rows)
-    write_text(out / "sweep.md", sweep_markdown(rows, str(config.dataset)))
     doc = {"dataset": str(config.dataset), "source_views": len(dataset), "grid": rows,
            "kept": {f"{n},{w}": r.kept for (n, w), r in grid.items()},
            "settings": config.settings(config.rule),
            "seconds": round(time.perf_counter() - start, 3)}
-    write_json(out / "sweep.json", doc)
+    with atomic_folder(config.out, overwrite=True, outputs=OUTPUTS) as folder:  # the three files together
+        write_csv(folder / "sweep.csv", rows)
+        write_text(folder / "sweep.md", sweep_markdown(rows, str(config.dataset)))
+        write_json(folder / "sweep.json", doc)
     return doc
 
 

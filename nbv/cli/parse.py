@@ -4,7 +4,9 @@ Nested configs are flattened (`tyro.conf.OmitArgPrefixes`): the camera's
 `width` is `--width` in every command that nests the camera, so one knob has
 one flag name everywhere, and a name clash between two nested configs fails
 when the parser is built (a test builds every command's parser). Field
-docstrings are the `--help` text.
+docstrings are the `--help` text. A value a config's `__post_init__` refuses
+surfaces as its one-line ValueError (exit status 2 in `nbv.cli.main`), not as
+tyro's error box.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from collections.abc import Sequence
 from typing import TypeVar
 
 import tyro
+from tyro._errors import InstantiationFailure, ParseErrorEvent, on_parse_error  # tyro is pinned exactly
 
 T = TypeVar("T")
 
@@ -20,6 +23,13 @@ MARKERS = (tyro.conf.OmitArgPrefixes,)
 """How every command's config becomes options: flat names, nested groups in `--help`."""
 
 
+def _refused_value(event: ParseErrorEvent) -> None:
+    """Re-raise a config's own ValueError (it names the field) instead of letting tyro box it."""
+    if isinstance(event, InstantiationFailure):
+        raise ValueError(event.message)
+
+
 def parse(cls: type[T], args: Sequence[str], prog: str, default: T | None = None) -> T:
     """The config `cls` from command-line `args` (`--help` prints the options and exits)."""
-    return tyro.cli(cls, args=list(args), prog=prog, default=default, config=MARKERS)
+    with on_parse_error(_refused_value):
+        return tyro.cli(cls, args=list(args), prog=prog, default=default, config=MARKERS)

@@ -70,7 +70,8 @@ class RandomPlanner(Planner):
 
     def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
         """`views` (default 13, the paper's Fig. 1 count) random viewpoints."""
-        return sample_viewpoints(env.config, views or self.default_views, np.random.default_rng(self.seed))
+        count = self.default_views if views is None else views
+        return sample_viewpoints(env.config, count, np.random.default_rng(self.seed))
 
 
 class CirclePlanner(Planner):
@@ -83,7 +84,7 @@ class CirclePlanner(Planner):
 
     def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
         """`views` (default 13) viewpoints on one ring."""
-        count = views or self.default_views
+        count = self.default_views if views is None else views
         mid = (env.config.low + env.config.high) / 2.0
         return [Viewpoint(float(mid[0]), TWO_PI * k / count, float(mid[2])) for k in range(count)]
 
@@ -117,7 +118,7 @@ class GreedyBoVPlanner(Planner):
         rng = np.random.default_rng(self.seed)
         env.reset()
         chosen = [env.viewpoint]
-        for _ in range((views or self.default_views) - 1):
+        for _ in range((self.default_views if views is None else views) - 1):
             best, best_reward, best_descriptors = None, -math.inf, None
             for view in sample_viewpoints(env.config, self.candidates, rng):
                 _, descriptors = env.capture(view)
@@ -137,19 +138,19 @@ class PolicyPlanner(Planner):
     def __init__(self, checkpoint: str | Path, sample: bool = False, seed: int = 0) -> None:
         self.sample, self.seed = sample, seed
         state = load_checkpoint(checkpoint)
-        config = checkpoint_config(state)
         try:
+            config = checkpoint_config(state, checkpoint)
             self.env_config = config_from_record(EnvConfig, config["env"])
             network = config_from_record(NetworkConfig, config["network"])
-        except (KeyError, TypeError, ValueError) as err:
+            self.actor = make_actor(self.env_config.history, self.env_config.obs_size, network)
+        except (KeyError, TypeError, ValueError, AttributeError, RuntimeError) as err:
             raise CheckpointError(f"checkpoint {checkpoint}: its config does not fit this toolkit: "
                                   f"{type(err).__name__}: {err}") from err
-        self.actor = make_actor(self.env_config.history, self.env_config.obs_size, network)
         prefix = "actor_network_params."
-        weights = {k[len(prefix):]: v for k, v in state["loss"].items() if k.startswith(prefix)}
         try:
+            weights = {k[len(prefix):]: v for k, v in state["loss"].items() if k.startswith(prefix)}
             self.actor.load_state_dict(weights)
-        except RuntimeError as err:
+        except (AttributeError, TypeError, RuntimeError) as err:
             raise CheckpointError(f"checkpoint {checkpoint}: actor weights do not fit: {err}") from err
         self.actor.eval()
 
@@ -169,7 +170,7 @@ class PolicyPlanner(Planner):
         exploration = ExplorationType.RANDOM if self.sample else ExplorationType.DETERMINISTIC
         with torch.no_grad(), set_exploration_type(exploration), torch.random.fork_rng():
             torch.manual_seed(self.seed)
-            while len(chosen) < (views or math.inf):
+            while len(chosen) < (math.inf if views is None else views):
                 td = env.step(self.actor(td))
                 chosen.append(env.viewpoint)
                 done = bool(td["next", "done"])

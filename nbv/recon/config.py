@@ -11,6 +11,11 @@ from typing import Annotated, Literal
 
 from tyro.conf import Suppress, arg
 
+MAX_BLOCK_RESOLUTION = 64
+"""Most voxels per block side."""
+MAX_INITIAL_VOXELS = 2**28
+"""Most voxels allocated up front (initial_blocks x block_resolution^3): about 5 GB with colour."""
+
 
 @dataclass(frozen=True)
 class ReconstructionConfig:
@@ -50,8 +55,13 @@ class ReconstructionConfig:
             raise ValueError(f"reconstruction min_observations must be >= 1, got {self.min_observations}")
         if not math.isfinite(self.ground_crop_voxels) or self.ground_crop_voxels < 0:
             raise ValueError(f"reconstruction ground_crop_voxels must be >= 0, got {self.ground_crop_voxels}")
-        if self.block_resolution < 2 or self.initial_blocks < 1:
-            raise ValueError("reconstruction block_resolution must be >= 2 and initial_blocks >= 1")
+        if not 2 <= self.block_resolution <= MAX_BLOCK_RESOLUTION:
+            raise ValueError(f"reconstruction block_resolution must lie in [2, {MAX_BLOCK_RESOLUTION}], "
+                             f"got {self.block_resolution}")
+        if not 1 <= self.initial_blocks * self.block_resolution**3 <= MAX_INITIAL_VOXELS:
+            raise ValueError(f"reconstruction initial_blocks must lie in [1, "
+                             f"{MAX_INITIAL_VOXELS // self.block_resolution**3}] at block_resolution "
+                             f"{self.block_resolution}, got {self.initial_blocks}")
 
     @property
     def ground_crop_m(self) -> float:

@@ -7,7 +7,8 @@ Writes DIR/metrics.json, one object per reference given under the keys
 the inputs and settings are recorded under `run` (docs/data-formats.md §8).
 Also writes DIR/heatmap.png and DIR/heatmap.ply: distances to the reference,
 or to the ground truth when no reference is given (skipped when MESH is a
-point cloud; docs/reconstruction.md §6).
+point cloud; docs/reconstruction.md §6). The files are swapped into DIR together
+(`common.io.atomic_folder`; other files in DIR are kept).
 """
 
 from __future__ import annotations
@@ -19,11 +20,10 @@ from typing import Annotated
 import trimesh
 from tyro.conf import Positional, arg
 
-from common.io import write_json
+from common.io import atomic_folder, check_output_folder, write_json
 from nbv.recon.config import HeatmapConfig, MetricsConfig
 from nbv.recon.heatmap import write_heatmap
 from nbv.recon.metrics import Geometry, SurfaceMetrics, evaluate_surfaces, load_geometry
-from nbv.recon.reconstruct import check_outputs
 from scenes import list_scenes, load_scene
 from scenes.normalise import up_to_z
 from scenes.spec import MeshOrientation
@@ -88,25 +88,33 @@ def evaluate(config: EvaluateConfig) -> dict[str, SurfaceMetrics]:
     if config.reference is None and gt.gt is None:
         raise ValueError("give --reference, --gt or both to compare against")
     out = Path(config.out)
-    check_outputs(out, OUTPUTS, config.overwrite)
+    check_output_folder(out, config.overwrite, OUTPUTS)
     prediction = load_geometry(config.mesh, "mesh")
     references: dict[str, Geometry] = {}
     if gt.gt is not None:
         references["gt"] = gt.load()
     if config.reference is not None:
         references["reference"] = load_geometry(config.reference, "reference")
+    with atomic_folder(out, config.overwrite, OUTPUTS) as folder:
+        return write_evaluation(config, prediction, references, folder)
+
+
+def write_evaluation(config: EvaluateConfig, prediction: Geometry, references: dict[str, Geometry],
+                     folder: Path) -> dict[str, SurfaceMetrics]:
+    """Compare `prediction` with each reference; write metrics.json (recording `config`) and the heat map
+    into `folder`."""
+    gt = config.ground_truth
     metrics = replace(config.metrics, seed=config.seed)
     results = evaluate_surfaces(prediction, references, metrics)
-    out.mkdir(parents=True, exist_ok=True)
     is_mesh = isinstance(prediction, trimesh.Trimesh)
     heat_against = "reference" if "reference" in references else "gt"
     if is_mesh:
-        write_heatmap(prediction, references[heat_against], out, config.heatmap,
+        write_heatmap(prediction, references[heat_against], folder, config.heatmap,
                       title=f"{Path(config.mesh).name}: distance to {heat_against}")
     run = {"mesh": str(config.mesh), "reference": None if config.reference is None else str(config.reference),
            "gt": gt.gt, "up_axis": gt.up_axis, "heatmap_against": heat_against if is_mesh else None,
            "metrics": asdict(metrics), "heatmap": asdict(config.heatmap)}
-    write_json(out / "metrics.json", {**{name: m.as_dict() for name, m in results.items()}, "run": run})
+    write_json(folder / "metrics.json", {**{name: m.as_dict() for name, m in results.items()}, "run": run})
     return results
 
 

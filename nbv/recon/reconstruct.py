@@ -1,4 +1,8 @@
-"""`nbv reconstruct`: TSDF fusion of a view dataset into OUT/mesh.ply, OUT/points.ply and a run summary."""
+"""`nbv reconstruct`: TSDF fusion of a view dataset into OUT/mesh.ply, OUT/points.ply and a run summary.
+
+The three files are written together: into a temporary folder beside OUT, swapped into place in one
+rename (other files in OUT are kept), so an interrupted run leaves OUT as it was.
+"""
 
 from __future__ import annotations
 
@@ -9,7 +13,7 @@ from typing import Annotated, Any
 
 from tyro.conf import Positional, arg
 
-from common.io import write_json
+from common.io import atomic_folder, check_output_folder, check_separate, write_json
 from nbv.recon.config import ReconstructionConfig
 from nbv.recon.tsdf import reconstruct_dataset, save_reconstruction
 from render.dataset import read_dataset
@@ -31,26 +35,23 @@ class ReconstructConfig:
     overwrite: bool = False
     """Replace mesh.ply, points.ply and reconstruction.json if the folder already holds them."""
 
-
-def check_outputs(out: Path, names: tuple[str, ...], overwrite: bool) -> None:
-    """Refuse (FileExistsError) when `out` already holds any of `names` and `overwrite` is off."""
-    existing = [name for name in names if (out / name).exists()]
-    if existing and not overwrite:
-        raise FileExistsError(f"{out} already holds {', '.join(existing)} (use --overwrite)")
+    def __post_init__(self) -> None:
+        check_separate(self.out, self.dataset, may_hold=True)  # other files in OUT are kept
 
 
 def reconstruct(config: ReconstructConfig) -> dict[str, Any]:
     """Fuse the dataset, write the outputs and return the run summary written to reconstruction.json."""
     out = Path(config.out)
-    check_outputs(out, OUTPUTS, config.overwrite)
+    check_output_folder(out, config.overwrite, OUTPUTS)
     dataset = read_dataset(config.dataset)
     start = time.perf_counter()
     recon = reconstruct_dataset(dataset, config.recon)
     seconds = time.perf_counter() - start
-    mesh_path, points_path = save_reconstruction(recon, out)
     summary = {"dataset": str(config.dataset), "views": recon.n_views, "seconds": round(seconds, 3),
-               "mesh": str(mesh_path), "points": str(points_path),
+               "mesh": str(out / "mesh.ply"), "points": str(out / "points.ply"),
                "vertices": len(recon.mesh.vertices), "faces": len(recon.mesh.faces),
                "n_points": len(recon.points.vertices), "config": asdict(config.recon)}
-    write_json(out / "reconstruction.json", summary)
+    with atomic_folder(out, config.overwrite, OUTPUTS) as folder:
+        save_reconstruction(recon, folder)
+        write_json(folder / "reconstruction.json", summary)
     return summary

@@ -86,9 +86,16 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
     return state
 
 
-def checkpoint_config(state: dict[str, Any]) -> dict[str, Any]:
-    """The run config stored in a checkpoint, as a nested dict."""
-    return json.loads(state["config"])
+def checkpoint_config(state: dict[str, Any], path: str | Path = "checkpoint") -> dict[str, Any]:
+    """The run config stored in a checkpoint, as a nested dict (CheckpointError naming `path` if not one)."""
+    try:
+        config = json.loads(state["config"])
+    except (TypeError, ValueError, RecursionError) as err:
+        raise CheckpointError(f"checkpoint {path}: its config is not JSON text: {err}") from err
+    if not isinstance(config, dict):
+        raise CheckpointError(f"checkpoint {path}: its config must be a JSON object, "
+                              f"got {type(config).__name__}")
+    return config
 
 
 def check_compatible(path: str | Path, saved: dict[str, Any], current: dict[str, Any],

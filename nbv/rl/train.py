@@ -68,7 +68,8 @@ def train(config: TrainConfig) -> Path:
     ckpt_path = run / CHECKPOINT
     resumed = load_checkpoint(ckpt_path) if ckpt_path.exists() else None
     if resumed is not None:
-        check_compatible(ckpt_path, checkpoint_config(resumed), config_record(config), RESUMABLE_CHANGES)
+        saved = checkpoint_config(resumed, ckpt_path)
+        check_compatible(ckpt_path, saved, config_record(config), RESUMABLE_CHANGES)
     write_json(run / "config.json", config_record(config))
     seed = config.collector.seed
     seed_everything(seed)

@@ -1,4 +1,5 @@
-"""The online problem (paper Sec. IV-V): the TorchRL env, the SAC agent; training in `nbv.rl.train`.
+"""The online problem (paper Sec. IV-V): the TorchRL env, its Gymnasium wrapper, the SAC agent; training in
+`nbv.rl.train`.
 
 Names are re-exported lazily (`common.lazy`), so importing a config module stays light.
 """
@@ -9,6 +10,7 @@ _EXPORTS = {
     "EnvConfig": "nbv.rl.config",
     "TrainConfig": "nbv.rl.config",
     "NBVEnv": "nbv.rl.env",
+    "NBVGymEnv": "nbv.rl.gym",
     "make_actor": "nbv.rl.agent",
     "make_critic": "nbv.rl.agent",
 }

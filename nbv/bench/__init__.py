@@ -6,6 +6,10 @@ Ratios that a goal compares are measured side by side in the same run.
 
 from __future__ import annotations
 
+import os
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass
 
 AREAS = (
@@ -37,3 +41,18 @@ class BenchResult:
     def as_dict(self) -> dict:
         """Plain dict for JSON."""
         return asdict(self)
+
+
+@contextmanager
+def temporary_cache() -> Iterator[str]:
+    """An empty `NBV_CACHE_DIR` for the block (cold-cache figures), restored afterwards."""
+    previous = os.environ.get("NBV_CACHE_DIR")
+    with tempfile.TemporaryDirectory() as cache:
+        os.environ["NBV_CACHE_DIR"] = cache
+        try:
+            yield cache
+        finally:
+            if previous is None:
+                os.environ.pop("NBV_CACHE_DIR")
+            else:
+                os.environ["NBV_CACHE_DIR"] = previous

@@ -15,11 +15,14 @@ import torch
 from tensordict import TensorDict
 from torchrl.envs.utils import ExplorationType, set_exploration_type
 
-from nbv.bench import BenchResult
+from nbv.bench import BenchResult, temporary_cache
 from nbv.features.sift import extract_features
 from nbv.rl.builders import make_environment, make_loss_module, make_sac_agent
-from nbv.rl.config import EnvConfig, NetworkConfig, OptimConfig
+from nbv.rl.config import EnvConfig, LatticeConfig, NetworkConfig, OptimConfig
 from nbv.rl.env import NBVEnv, gray_frame
+from nbv.rl.lattice import build_lattice
+from render.camera import UAVCamera
+from render.renderer import MitsubaRenderer
 from render.viewpoint import Viewpoint
 from scenes import DEFAULT_SCENE
 from scenes.spec import SceneSet
@@ -94,6 +97,35 @@ def planning_ms(config: EnvConfig, repeats: int) -> dict[str, float]:
     return {k: 1000.0 * v / len(images) for k, v in totals.items()}
 
 
+def lattice_vs_render(config: EnvConfig, steps: int) -> list[BenchResult]:
+    """Env steps/s rendering every view against snapping to a cached view lattice, side by side.
+
+    At the documented training settings (160x120, 4 spp, OpenCV SIFT, orbit actions); the lattice's
+    one-time build per scene is timed on an empty cache and reported apart.
+    """
+    train = replace(config, camera=UAVCamera(160, 120), render=replace(config.render, spp=4),
+                    bov=replace(config.bov, features="opencv"), action_mode="orbit")
+    on_lattice = replace(train, lattice=LatticeConfig(enabled=True))
+    rendering = env_steps_per_s(train, 1, steps)
+    scene = on_lattice.scenes.specs()[0].load()
+    renderer = MitsubaRenderer(scene, on_lattice.camera, on_lattice.render)
+    with temporary_cache():
+        start = time.perf_counter()
+        build_lattice(scene, renderer, on_lattice, on_lattice.bov.feature_config(), progress=False)
+        build = time.perf_counter() - start
+        snapping = env_steps_per_s(on_lattice, 1, 10 * steps)
+    nodes = on_lattice.lattice.lattice_radii * on_lattice.lattice.lattice_azimuths
+    nodes *= on_lattice.lattice.lattice_elevations
+    dr, daz, de = on_lattice.snapping_error
+    return [
+        BenchResult("rl", "env steps/s, rendering, 160x120 4 spp opencv", rendering, "steps/s"),
+        BenchResult("rl", "env steps/s, view lattice, 160x120 4 spp opencv", snapping, "steps/s"),
+        BenchResult("rl", "view lattice over rendering env speed-up", snapping / rendering, "x"),
+        BenchResult("rl", f"view lattice build, {nodes} nodes, cold cache (once per scene)", build, "s",
+                    f"snapping error <= {dr:g} m, {daz:g} deg azimuth, {de:g} deg elevation"),
+    ]
+
+
 def run(quick: bool) -> list[BenchResult]:
     """Env steps/s (1 and 2 workers, 320x240), SAC updates/s, planning ms/step (1 torch thread)."""
     torch.set_num_threads(1)
@@ -110,7 +142,8 @@ def run(quick: bool) -> list[BenchResult]:
         met = "met" if total <= GOAL_PLANNING_MS else "NOT met"
         name = f"planning ms/step without rendering ({backend} SIFT + BoV + policy)"
         results.append(BenchResult("rl", name, total, "ms", f"<= {GOAL_PLANNING_MS:g}: {met}"))
-    # Env throughput last: after in-process renders and a ParallelEnv, torch ops in this process
+    results.extend(lattice_vs_render(config, steps))
+    # ParallelEnv throughput last: after in-process renders and a ParallelEnv, torch ops in this process
     # were measured 10-20x slower (thread pools left competing), which would skew the figures above.
     single = env_steps_per_s(config, 1, steps)
     double = env_steps_per_s(config, 2, steps)

@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
 import time
 
-from nbv.bench import BenchResult
+from nbv.bench import BenchResult, temporary_cache
 from scenes.presets import PRESETS, build_preset
 from scenes.textures import make_texture
 
@@ -23,34 +21,26 @@ def run(quick: bool) -> list[BenchResult]:
         BenchResult("scenes", "texture generation brick_red 1024 px (cold)", time.perf_counter() - start, "s")
     )
     repeats = 1 if quick else 3
-    with tempfile.TemporaryDirectory() as cache:
-        previous = os.environ.get("NBV_CACHE_DIR")
-        os.environ["NBV_CACHE_DIR"] = cache
-        try:
-            for name in PRESETS:
-                start = time.perf_counter()
-                build_preset(name)
-                results.append(
-                    BenchResult(
-                        "scenes", f"{name} build, cold texture cache", time.perf_counter() - start, "s"
-                    )
+    with temporary_cache():
+        for name in PRESETS:
+            start = time.perf_counter()
+            build_preset(name)
+            results.append(
+                BenchResult(
+                    "scenes", f"{name} build, cold texture cache", time.perf_counter() - start, "s"
                 )
-                best = min(_timed_build(name) for _ in range(repeats))
-                met = "met" if best <= BUILD_GOAL_S else "NOT met"
-                results.append(
-                    BenchResult(
-                        "scenes",
-                        f"{name} build, warm texture cache",
-                        best,
-                        "s",
-                        f"<= {BUILD_GOAL_S:g} ({met})",
-                    )
+            )
+            best = min(_timed_build(name) for _ in range(repeats))
+            met = "met" if best <= BUILD_GOAL_S else "NOT met"
+            results.append(
+                BenchResult(
+                    "scenes",
+                    f"{name} build, warm texture cache",
+                    best,
+                    "s",
+                    f"<= {BUILD_GOAL_S:g} ({met})",
                 )
-        finally:
-            if previous is None:
-                os.environ.pop("NBV_CACHE_DIR")
-            else:
-                os.environ["NBV_CACHE_DIR"] = previous
+            )
     return results
 
 

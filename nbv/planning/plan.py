@@ -7,7 +7,9 @@ against the ground-truth mesh (`gt`) and against the full-scan reconstruction
 (`reference`, paper Sec. V-B), and the trajectory plot. The reference is
 `--reference MESH` when given; otherwise the hemisphere scan of the same
 scene and camera (`render.scan_cache.full_scan`) is reconstructed once and
-cached beside that scan (docs/rl.md §10, docs/reconstruction.md).
+cached beside that scan (docs/rl.md §10, docs/reconstruction.md). The output
+folder is written whole into a temporary folder and swapped into place at the
+end (`common.io.atomic_folder`): an interrupted run leaves `--out` as it was.
 """
 
 from __future__ import annotations
@@ -19,19 +21,20 @@ from pathlib import Path
 
 import numpy as np
 
-from common.io import write_json
+from common.io import atomic_folder, check_output_folder, write_json
 from common.provenance import config_record
 from nbv.bov.config import BoVConfig
 from nbv.planning.planners import Planner, PolicyPlanner, make_planner
 from nbv.recon.config import MetricsConfig, ReconstructionConfig
-from nbv.recon.evaluate import EvaluateConfig, GroundTruth, evaluate
+from nbv.recon.evaluate import EvaluateConfig, GroundTruth, write_evaluation
+from nbv.recon.metrics import load_geometry
 from nbv.recon.tsdf import reconstruct_dataset, save_reconstruction
-from nbv.rl.config import EnvConfig
+from nbv.rl.config import EnvConfig, LatticeConfig
 from nbv.rl.env import NBVEnv
 from nbv.viz.figures import plot_trajectory
 from render.camera import UAVCamera
 from render.capture import capture_dataset
-from render.dataset import check_output_folder, read_dataset
+from render.dataset import read_dataset
 from render.scan import HemispherePlan
 from render.scan_cache import full_scan
 from render.settings import RenderSettings
@@ -66,6 +69,10 @@ class PlanSettings:
     recon: ReconstructionConfig = ReconstructionConfig()
     """TSDF fusion of the captured views (and of the reference scan)."""
 
+    def __post_init__(self) -> None:
+        if self.views is not None and self.views < 1:
+            raise ValueError(f"views must be >= 1 (or left out for the planner's default), got {self.views}")
+
     def plan_config(self, planner: str, seed: int, out: Path, overwrite: bool = False) -> PlanConfig:
         """The `nbv plan` run of one planner and seed under these settings."""
         shared = {f.name: getattr(self, f.name) for f in fields(PlanSettings)}
@@ -95,12 +102,15 @@ def scan_env_config(config: PlanSettings) -> EnvConfig:
 
 
 def planning_env_config(config: PlanConfig, planner: Planner) -> EnvConfig:
-    """The env the planner works in: a policy's training settings on this scene, else `scan_env_config`."""
+    """The env the planner works in: a policy's training settings on this scene, else `scan_env_config`.
+
+    Planning always renders exact viewpoints: a policy trained on a view lattice plans without it.
+    """
     own = scan_env_config(config)
     if isinstance(planner, PolicyPlanner):
         trained = planner.env_config
         render = replace(trained.render, variant=config.render.variant)
-        return replace(trained, scenes=own.scenes, render=render)
+        return replace(trained, scenes=own.scenes, render=render, lattice=LatticeConfig())
     return own
 
 
@@ -130,8 +140,10 @@ def reference_mesh(config: PlanConfig, scene: Scene | None = None) -> Path:
     folder = full.root / f"reconstruction_{config.recon.voxel_size_m * 1000:g}mm"
     key = config_record(config.recon)
     if not (folder / "mesh.ply").is_file() or _stored(folder / RECONSTRUCTION_KEY) != key:
-        save_reconstruction(reconstruct_dataset(full, config.recon), folder)
-        write_json(folder / RECONSTRUCTION_KEY, key)
+        recon = reconstruct_dataset(full, config.recon)
+        with atomic_folder(folder, overwrite=True) as tmp:
+            save_reconstruction(recon, tmp)
+            write_json(tmp / RECONSTRUCTION_KEY, key)
     return folder / "mesh.ply"
 
 
@@ -149,26 +161,28 @@ def plan_scan(config: PlanConfig) -> dict:
     planner = make_planner(config.planner, config.seed, config.candidates)
     views, plan_s = choose_views(config, planner, planning_env_config(config, planner))
     scene = config.scene.load()
-    out.mkdir(parents=True, exist_ok=True)
     settings = replace(config.render, seed=config.seed)
     meta = {"planner": config.planner, "up_axis": config.scene.up_axis}
-    dataset = capture_dataset(scene, config.camera, views, out / "views", settings, config.render.variant,
-                              meta, overwrite=True, progress=False)
-    recon = reconstruct_dataset(read_dataset(dataset), config.recon)
-    mesh_path, _ = save_reconstruction(recon, out)
-    gt_path = out / "gt.ply"
-    scene.target_mesh().export(gt_path)
-    gt = GroundTruth(gt=str(gt_path))  # the normalised target: z up whatever the scene file's axis
-    results = evaluate(EvaluateConfig(mesh=mesh_path, reference=reference_mesh(config, scene),
-                                      ground_truth=gt, out=out, metrics=config.metrics, seed=config.seed,
-                                      overwrite=True))
-    doc = {"planner": config.planner, "scene": config.scene.scene, "views": len(views), "planning_s": plan_s,
-           "viewpoints": [v.as_array().tolist() for v in views],
-           "config": config_record(config),
-           **{name: result.as_dict() for name, result in results.items()}}
-    write_json(out / "plan.json", doc)
-    poses = np.stack([viewpoint_to_c2w(v, scene.center()) for v in views])
-    plot_trajectory(poses, scene.target_mesh(), out / "trajectory.png",
-                    title=f"{config.planner} on {Path(config.scene.scene).name}: {len(views)} views",
-                    numbered=True)
+    with atomic_folder(out, config.overwrite) as folder:
+        dataset = capture_dataset(scene, config.camera, views, folder / "views", settings,
+                                  config.render.variant, meta, overwrite=True, progress=False)
+        recon = reconstruct_dataset(read_dataset(dataset), config.recon)
+        save_reconstruction(recon, folder)
+        scene.target_mesh().export(folder / "gt.ply")
+        reference = reference_mesh(config, scene)
+        gt = GroundTruth(gt=str(out / "gt.ply"))  # the normalised target: z up whatever the scene file's axis
+        evaluation = EvaluateConfig(mesh=out / "mesh.ply", reference=reference, ground_truth=gt, out=out,
+                                    metrics=config.metrics, seed=config.seed, overwrite=True)
+        references = {"gt": load_geometry(folder / "gt.ply", "gt"),
+                      "reference": load_geometry(reference, "reference")}
+        results = write_evaluation(evaluation, load_geometry(folder / "mesh.ply", "mesh"), references, folder)
+        doc = {"planner": config.planner, "scene": config.scene.scene, "views": len(views),
+               "planning_s": plan_s, "viewpoints": [v.as_array().tolist() for v in views],
+               "config": config_record(config),
+               **{name: result.as_dict() for name, result in results.items()}}
+        write_json(folder / "plan.json", doc)
+        poses = np.stack([viewpoint_to_c2w(v, scene.center()) for v in views])
+        plot_trajectory(poses, scene.target_mesh(), folder / "trajectory.png",
+                        title=f"{config.planner} on {Path(config.scene.scene).name}: {len(views)} views",
+                        numbered=True)
     return doc

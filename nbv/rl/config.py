@@ -13,15 +13,37 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
+from tyro.conf import arg
 
 from nbv.bov.config import BoVConfig
 from render.camera import UAVCamera
+from render.scan import check_camera_distance
 from render.settings import RenderSettings
 from render.viewpoint import TWO_PI
 from scenes.spec import SceneSet
+
+
+@dataclass(frozen=True)
+class LatticeConfig:
+    """Training on a per-scene view lattice rendered once instead of rendering every step."""
+
+    enabled: Annotated[bool, arg(name="lattice")] = False
+    """Snap each viewpoint to the nearest node of a cached per-scene lattice (fast training); evaluation
+    and `nbv plan` always render exact viewpoints."""
+    lattice_radii: int = 3
+    """Lattice nodes along R, spanning [radius_min, radius_max]."""
+    lattice_azimuths: int = 36
+    """Lattice nodes around the target (10 degree steps at 36)."""
+    lattice_elevations: int = 6
+    """Lattice nodes along the elevation, spanning [elevation_min_deg, elevation_max_deg]."""
+
+    def __post_init__(self) -> None:
+        for name in ("lattice_radii", "lattice_azimuths", "lattice_elevations"):
+            if not 1 <= getattr(self, name) <= 360:
+                raise ValueError(f"{name} must lie in [1, 360], got {getattr(self, name)}")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -36,14 +58,16 @@ class EnvConfig:
     """How views are rendered."""
     bov: BoVConfig = BoVConfig(ranges=8)
     """The Bag of Views of the reward (paper Sec. IV)."""
+    lattice: LatticeConfig = LatticeConfig()
+    """Optional view lattice for fast training."""
     obs_size: int = 64
     """Side of the square grayscale frames the policy sees, pixels."""
     history: int = 5
     """Frames and viewpoints in the state (the paper's tau)."""
     radius_min: float = 1.5
-    """Smallest allowed camera distance from the scene centre, metres."""
+    """Smallest allowed camera distance from the scene centre, metres (at least 1: outside the target)."""
     radius_max: float = 2.5
-    """Largest allowed camera distance from the scene centre, metres."""
+    """Largest allowed camera distance from the scene centre, metres (at most far_m - 1)."""
     elevation_min_deg: float = 5.0
     """Lowest allowed elevation, degrees."""
     elevation_max_deg: float = 80.0
@@ -60,6 +84,8 @@ class EnvConfig:
     def __post_init__(self) -> None:
         if not 0 < self.radius_min <= self.radius_max:
             raise ValueError(f"need 0 < radius_min <= radius_max, got {self.radius_min}, {self.radius_max}")
+        check_camera_distance("radius_min", self.radius_min, self.camera)
+        check_camera_distance("radius_max", self.radius_max, self.camera)
         if not -90 < self.elevation_min_deg <= self.elevation_max_deg < 90:
             raise ValueError("need -90 < elevation_min_deg <= elevation_max_deg < 90, got "
                              f"{self.elevation_min_deg}, {self.elevation_max_deg}")
@@ -79,6 +105,15 @@ class EnvConfig:
         """Upper bounds of (R, azimuth, elevation), radians."""
         return np.array([self.radius_max, TWO_PI, math.radians(self.elevation_max_deg)])
 
+    @property
+    def snapping_error(self) -> tuple[float, float, float]:
+        """The largest distance of a viewpoint from its lattice node: (R m, azimuth deg, elevation deg)."""
+        grid = self.lattice
+        half = [(hi - lo) / (2 * (n - 1)) if n > 1 else hi - lo for lo, hi, n in (
+            (self.radius_min, self.radius_max, grid.lattice_radii),
+            (self.elevation_min_deg, self.elevation_max_deg, grid.lattice_elevations))]
+        return half[0], 180.0 / grid.lattice_azimuths, half[1]
+
 
 @dataclass(frozen=True)
 class NetworkConfig:
@@ -90,6 +125,11 @@ class NetworkConfig:
     """Width of the fully connected layers (the paper's 128)."""
     location_hidden: int = 64
     """Width of the first fully connected layer of the location sub-networks (the paper's 64)."""
+
+    def __post_init__(self) -> None:
+        for name in ("channels", "hidden", "location_hidden"):
+            if not 1 <= getattr(self, name) <= 4096:
+                raise ValueError(f"network {name} must lie in [1, 4096], got {getattr(self, name)}")
 
 
 @dataclass(frozen=True)
@@ -129,6 +169,12 @@ class ReplayBufferConfig:
     batch_size: int = 8
     """Transitions per gradient step (Table 1)."""
 
+    def __post_init__(self) -> None:
+        if self.batch_size < 1:
+            raise ValueError(f"batch_size must be >= 1, got {self.batch_size}")
+        if self.buffer_size < self.batch_size:
+            raise ValueError(f"buffer_size must be >= batch_size ({self.batch_size}), got {self.buffer_size}")
+
 
 @dataclass(frozen=True)
 class OptimConfig:
@@ -150,6 +196,18 @@ class OptimConfig:
     """Rewards are multiplied by this in the losses (logs keep raw rewards): the same as a temperature of
     alpha / reward_scale. Table 1's alpha with 1.0; BoV rewards of about +-20 then leave the entropy term
     too weak to keep the action dimensions the reward ignores spread."""
+
+    def __post_init__(self) -> None:
+        for name in ("lr", "alpha", "updates_per_frame", "reward_scale"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"{name} must be positive and finite, got {value!r}")
+        for name in ("gamma", "target_tau"):
+            value = getattr(self, name)
+            if not 0 < value <= 1:
+                raise ValueError(f"{name} must lie in (0, 1], got {value!r}")
+        if self.target_update_interval < 1:
+            raise ValueError(f"target_update_interval must be >= 1, got {self.target_update_interval}")
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -49,8 +49,10 @@ from torchrl.envs import EnvBase
 from nbv.bov.bag import BagOfViews
 from nbv.features.sift import extract_features
 from nbv.rl.config import EnvConfig
+from nbv.rl.lattice import ViewLattice, build_lattice
 from render.renderer import MitsubaRenderer
 from render.viewpoint import TWO_PI, Viewpoint, viewpoint_to_c2w
+from scenes.model import Scene
 from scenes.spec import SceneSpec
 
 
@@ -133,6 +135,8 @@ class NBVEnv(EnvBase):
         )
         self._scenes = config.scenes.specs()
         self._renderers: dict[str, MitsubaRenderer] = {}
+        self._lattices: dict[str, ViewLattice] = {}
+        self._loaded: dict[str, Scene] = {}
         self._features = config.bov.feature_config()
         self._bov: BagOfViews | None = None
         self._resume_pending = False
@@ -158,7 +162,7 @@ class NBVEnv(EnvBase):
         self._episode += 1
         low, high = self.config.low, self.config.high
         radius, azimuth, elevation = low + self._rng.random(3) * (high - low)
-        self._view = Viewpoint(float(radius), float(azimuth), float(elevation))
+        self._view = self.snap(Viewpoint(float(radius), float(azimuth), float(elevation)))
         self.bov.reset()
         frame, descriptors = self.capture(self._view)
         self.bov.update(descriptors, self._view.azimuth)
@@ -170,7 +174,7 @@ class NBVEnv(EnvBase):
         return self._observation()
 
     def _step(self, tensordict: TensorDictBase) -> TensorDictBase:
-        view = action_to_viewpoint(tensordict["action"], self._view, self.config)
+        view = self.snap(action_to_viewpoint(tensordict["action"], self._view, self.config))
         frame, descriptors = self.capture(view)
         reward = self.bov.reward(descriptors, view.azimuth)
         self._progress += wrap_angle(view.azimuth - self._view.azimuth)
@@ -231,16 +235,38 @@ class NBVEnv(EnvBase):
         self._views_rendered += 1
         return renderer.render_rgb(viewpoint_to_c2w(view, renderer.center), seed=seed)
 
+    def snap(self, view: Viewpoint) -> Viewpoint:
+        """`view` itself, or with a lattice (training) the nearest lattice node of the current scene."""
+        return self._lattice(self._scene).snap(view)[0] if self.config.lattice.enabled else view
+
     def capture(self, view: Viewpoint) -> tuple[np.ndarray, torch.Tensor]:
-        """Render `view` of the current scene: its policy frame (S x S uint8), SIFT descriptors (M, 128)."""
+        """The policy frame (S x S uint8) and SIFT descriptors (M, 128) of `view` of the current scene.
+
+        Rendered, or with a lattice read from the cache at the nearest node (`snap` first to see it).
+        """
+        if self.config.lattice.enabled:
+            lattice = self._lattice(self._scene)
+            return lattice.observe(lattice.snap(view)[1])
         rgb = self.render_view(view)
         descriptors = torch.as_tensor(extract_features([rgb], self._features)[0].descriptors)
         return gray_frame(rgb, self.config.obs_size), descriptors
 
     def _renderer(self, spec: SceneSpec) -> MitsubaRenderer:
         if spec.scene not in self._renderers:
-            self._renderers[spec.scene] = MitsubaRenderer(spec.load(), self.config.camera, self._render)
+            self._renderers[spec.scene] = MitsubaRenderer(self._load(spec), self.config.camera, self._render)
         return self._renderers[spec.scene]
+
+    def _load(self, spec: SceneSpec) -> Scene:
+        if spec.scene not in self._loaded:
+            self._loaded[spec.scene] = spec.load()
+        return self._loaded[spec.scene]
+
+    def _lattice(self, spec: SceneSpec) -> ViewLattice:
+        if spec.scene not in self._lattices:
+            renderer = self._renderer(spec)
+            self._lattices[spec.scene] = build_lattice(self._load(spec), renderer, self.config,
+                                                       self._features, progress=False)
+        return self._lattices[spec.scene]
 
     def _observation(self, terminated: bool = False, truncated: bool = False) -> TensorDict:
         return TensorDict({

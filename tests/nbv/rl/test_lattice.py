@@ -1,0 +1,102 @@
+"""The view lattice: snapping against hand-worked nodes, the cache against direct renders, the env on it."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import torch
+
+from nbv.bov.config import BoVConfig
+from nbv.features.sift import extract_features
+from nbv.rl.config import EnvConfig, LatticeConfig
+from nbv.rl.env import NBVEnv, gray_frame
+from nbv.rl.lattice import ViewLattice, lattice_axes
+from render.camera import UAVCamera
+from render.settings import RenderSettings
+from render.viewpoint import Viewpoint, viewpoint_to_c2w
+from scenes.spec import SceneSet
+
+GRID = LatticeConfig(enabled=True, lattice_radii=3, lattice_azimuths=36, lattice_elevations=6)
+
+
+def config(grid: LatticeConfig = GRID, **kwargs) -> EnvConfig:
+    return EnvConfig(scenes=SceneSet(scene=("test_building",)), lattice=grid, **kwargs)
+
+
+def empty_lattice(cfg: EnvConfig) -> ViewLattice:
+    axes = lattice_axes(cfg)
+    n = math.prod(len(a) for a in axes)
+    return ViewLattice(np.zeros((n, 2, 2), np.uint8), np.zeros(n, int), torch.zeros(0, 128), axes)
+
+
+def test_axes_and_snapping_error_by_hand():
+    cfg = config()
+    radii, azimuths, elevations = lattice_axes(cfg)
+    assert radii.tolist() == [1.5, 2.0, 2.5]
+    assert np.degrees(azimuths[:3]).round(9).tolist() == [0.0, 10.0, 20.0]
+    assert np.degrees(elevations).round(9).tolist() == [5.0, 20.0, 35.0, 50.0, 65.0, 80.0]
+    assert cfg.snapping_error == pytest.approx((0.25, 5.0, 7.5))
+
+
+def test_snap_wraps_the_azimuth_and_picks_the_nearest_node():
+    lattice = empty_lattice(config())
+    node, index = lattice.snap(Viewpoint(2.2, math.radians(356.0), math.radians(27.0)))
+    assert (node.radius, node.azimuth, round(math.degrees(node.elevation), 9)) == (2.0, 0.0, 20.0)
+    assert index == np.ravel_multi_index((1, 0, 1), (3, 36, 6))
+
+
+def test_every_viewpoint_lies_within_the_snapping_error_of_its_node():
+    cfg = config()
+    lattice = empty_lattice(cfg)
+    rng = np.random.default_rng(0)
+    dr, daz, del_ = cfg.snapping_error
+    for r, az, el in cfg.low + rng.random((500, 3)) * (cfg.high - cfg.low):
+        node, _ = lattice.snap(Viewpoint(r, az, el))
+        assert abs(node.radius - r) <= dr + 1e-12
+        assert abs(math.degrees(math.remainder(node.azimuth - az, 2 * math.pi))) <= daz + 1e-9
+        assert abs(math.degrees(node.elevation - el)) <= del_ + 1e-9
+
+
+def test_env_on_a_lattice_sees_cached_node_renders_and_reuses_the_cache(monkeypatch):
+    grid = LatticeConfig(enabled=True, lattice_radii=2, lattice_azimuths=4, lattice_elevations=2)
+    cfg = config(grid, camera=UAVCamera(64, 48), render=RenderSettings(spp=1), obs_size=16,
+                 bov=BoVConfig(ranges=4, words=5, features="opencv"), action_mode="orbit")
+    env = NBVEnv(cfg, seed=3)
+    env.reset()
+    start = env.viewpoint
+    assert start in [Viewpoint(r, a, e) for r, a, e in np.stack(np.meshgrid(*lattice_axes(cfg),
+                                                                           indexing="ij"), -1).reshape(-1, 3)]
+    # The cached node equals a direct render of that node with the node's seed (its index).
+    lattice = env._lattice(env._scene)
+    node, index = lattice.snap(start)
+    renderer = env._renderer(env._scene)
+    rgb = renderer.render_rgb(viewpoint_to_c2w(node, renderer.center), seed=index)
+    frame, descriptors = lattice.observe(index)
+    assert np.array_equal(frame, gray_frame(rgb, 16))
+    direct = extract_features([rgb], cfg.bov.feature_config())[0].descriptors
+    assert torch.allclose(descriptors, direct.half().float())
+    # A second env reads the cache: it never renders, yet steps with rewards.
+    monkeypatch.setattr("render.renderer.MitsubaRenderer.render_rgb",
+                        lambda *a, **k: pytest.fail("a lattice env rendered"))
+    again = NBVEnv(cfg, seed=3)
+    td = again.rollout(3)
+    assert td["next", "reward"].shape == (3, 1)
+    assert again.viewpoint.azimuth in lattice_axes(cfg)[1]
+
+
+def test_planning_env_renders_exact_viewpoints(tmp_path):
+    from nbv.planning.plan import planning_env_config
+    from nbv.planning.planners import PolicyPlanner
+
+    class Trained(PolicyPlanner):
+        def __init__(self) -> None:
+            self.env_config = config()
+
+    from nbv.planning.plan import PlanConfig
+    from scenes.spec import SceneSpec
+
+    plan = PlanConfig(scene=SceneSpec(scene="test_building"), planner="policy:x", out=tmp_path)
+    env_config = planning_env_config(plan, Trained())
+    assert env_config.lattice.enabled is False

@@ -69,6 +69,8 @@ def check_output_folder(out: Path, overwrite: bool, outputs: tuple[str, ...] | N
     parent = out.parent
     while not parent.exists():
         parent = parent.parent
+    if not parent.is_dir():
+        raise FileNotFoundError(f"output folder {out} cannot be made: {parent} is a file, not a folder")
     if not os.access(parent, os.W_OK | os.X_OK):
         raise PermissionError(f"output folder {out} is not writable (no write access to {parent})")
 
@@ -186,14 +188,28 @@ def atomic_folder(out: str | Path, overwrite: bool = False,
     """
     out = Path(out)
     check_output_folder(out, overwrite, outputs)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-{os.getpid()}-", dir=out.parent))
-    try:
-        tmp.chmod(0o777 & ~current_umask())  # mkdtemp makes 0700; outputs are shared like any folder
+    with scratch_folder(out) as tmp:
         if outputs is not None and out.is_dir():
             _carry(out, tmp, outputs)
         yield tmp
         replace_folder(tmp, out)
+
+
+@contextmanager
+def scratch_folder(out: str | Path) -> Iterator[Path]:
+    """A new empty folder beside `out`, named like `atomic_folder`'s (a dead run's is cleaned up), removed
+    when the block ends. Where it cannot be made: FileNotFoundError or PermissionError naming `out`."""
+    out = Path(out)
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-{os.getpid()}-", dir=out.parent))
+    except (FileNotFoundError, FileExistsError, NotADirectoryError) as err:
+        raise FileNotFoundError(f"output folder {out} cannot be made: {err.strerror}") from None
+    except OSError as err:
+        raise PermissionError(f"output folder {out} cannot be made: {err.strerror}") from None
+    try:
+        tmp.chmod(0o777 & ~current_umask())  # mkdtemp makes 0700; outputs are shared like any folder
+        yield tmp
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 

@@ -162,6 +162,9 @@ class DatasetWriter:
             self._stack.__exit__(exc_type, exc, tb)
             return
         with self._stack:
+            if not self._frames:
+                raise ValueError(f"dataset {self.out}: no frames were added "
+                                 "(a dataset needs at least one view)")
             write_json(self._tmp / "transforms.json", transforms_json(self.camera, self._frames, self.meta))
 
 
@@ -192,6 +195,8 @@ def read_dataset(path: str | Path) -> ViewDataset:
     camera = read_camera(doc, nbv, doc_path)
     center = read_center(nbv, doc_path)
     raw_frames = typed_field(doc, "frames", list, doc_path)
+    if not raw_frames:
+        raise DatasetError(f"{doc_path}: field frames is empty (a dataset needs at least one view)")
     frames = tuple(_read_frame(root, i, f, center, doc_path) for i, f in enumerate(raw_frames))
     return ViewDataset(root, camera, frames, dict(nbv))
 

@@ -235,18 +235,30 @@ def _png_chunks(data: bytes, path: Path) -> tuple[int, int, int, int]:
         pos = end
 
 
+def image_bytes(path: Path, width: int, height: int) -> bytes:
+    """The bytes of the image file at `path`, refused (DatasetError) unread when larger than a
+    `width` x `height` image can be (8 bytes a pixel + 1 MiB), so a stray huge file is never loaded."""
+    limit = 8 * width * height + 2**20
+    try:
+        if not path.is_file():  # a FIFO or device would block or never end
+            raise DatasetError(f"{path}: not a regular file")
+        if path.stat().st_size > limit:
+            raise DatasetError(f"{path}: file larger than {limit} bytes for a {width}x{height} image")
+        with open(path, "rb") as handle:
+            data = handle.read(limit + 1)
+    except OSError as err:
+        raise DatasetError(f"{path}: cannot read image: {err}") from err
+    if len(data) > limit:  # the file grew after the size check
+        raise DatasetError(f"{path}: file larger than {limit} bytes for a {width}x{height} image")
+    return data
+
+
 def read_png(path: Path, width: int, height: int, depth: bool) -> np.ndarray:
     """Decode the PNG at `path` once its size, format and checksums are checked.
 
     RGB: H x W x 3 uint8 (8-bit or palette PNG). Depth: H x W uint16 (16-bit gray PNG).
     """
-    limit = 8 * width * height + 2**20
-    try:
-        if path.stat().st_size > limit:
-            raise DatasetError(f"{path}: file larger than {limit} bytes for a {width}x{height} image")
-        data = path.read_bytes()
-    except OSError as err:
-        raise DatasetError(f"{path}: cannot read image: {err}") from err
+    data = image_bytes(path, width, height)
     w, h, bits, colour = _png_chunks(data, path)
     if (w, h) != (width, height):
         raise DatasetError(f"{path}: image is {w}x{h}, transforms.json says w={width}, h={height}")

@@ -70,6 +70,16 @@ class CirclePlan:
     """Overlap of consecutive images, used when `views` is None."""
 
 
+MAX_VIEWS = 100_000
+"""Most views one scan plan may ask for (a typo's ten million views would run for days)."""
+
+
+def check_views(name: str, count: int) -> None:
+    """Refuse (ValueError naming `name`) a view count below 1 or above `MAX_VIEWS`."""
+    if not 1 <= count <= MAX_VIEWS:
+        raise ValueError(f"{name} must lie in [1, {MAX_VIEWS}], got {count}")
+
+
 def _check_overlap(name: str, value: float) -> None:
     if not 0.0 <= value < 1.0:
         raise ValueError(f"{name} must lie in [0, 1), got {value}")
@@ -106,8 +116,9 @@ def hemisphere_scan(camera: UAVCamera, plan: HemispherePlan = HemispherePlan()) 
         if math.pi / 2 - elevation < 1e-6:
             views.append(Viewpoint(plan.radius, 0.0, math.pi / 2))
             break
-        count = math.ceil(TWO_PI / azimuth_step(camera, plan.end_overlap, elevation) - 1e-9)
-        views.extend(ring(plan.radius, elevation, max(count, 1)))
+        count = max(math.ceil(TWO_PI / azimuth_step(camera, plan.end_overlap, elevation) - 1e-9), 1)
+        check_views("hemisphere views (from end_overlap and side_overlap)", len(views) + count)
+        views.extend(ring(plan.radius, elevation, count))
         elevation = min(elevation + step, hi) if elevation < hi - 1e-9 else hi + 1.0
     return views
 
@@ -119,10 +130,10 @@ def circle_scan(camera: UAVCamera, plan: CirclePlan = CirclePlan()) -> list[View
     if not -math.pi / 2 < elevation < math.pi / 2:
         raise ValueError(f"circle elevation_deg must lie in (-90, 90), got {plan.elevation_deg}")
     if plan.views is not None:
-        if plan.views < 1:
-            raise ValueError(f"circle views must be >= 1, got {plan.views}")
+        check_views("circle views", plan.views)
         return ring(plan.radius, elevation, plan.views)
     count = math.ceil(TWO_PI / azimuth_step(camera, plan.end_overlap, elevation) - 1e-9)
+    check_views("circle views (from end_overlap)", count)
     return ring(plan.radius, elevation, count)
 
 
@@ -148,7 +159,7 @@ class ScanConfig:
     side_overlap: float = 0.8
     """Overlap of images on neighbouring rings (hemisphere)."""
     views: int | None = None
-    """Number of views (circle); default: derived from --end-overlap."""
+    """Number of views (circle, 1 to 100000); default: derived from --end-overlap."""
     elevation: float = 30.0
     """Elevation of the circle, degrees (circle)."""
     seed: int = 0
@@ -158,6 +169,8 @@ class ScanConfig:
 
     def __post_init__(self) -> None:
         check_camera_distance("radius", self.radius, self.camera)
+        if self.views is not None:
+            check_views("views", self.views)
 
     def viewpoints(self) -> list[Viewpoint]:
         """The viewpoints the plan asks for."""

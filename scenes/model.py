@@ -86,6 +86,10 @@ class Scene:
 
     def target_mesh(self) -> trimesh.Trimesh:
         """The target parts merged into one mesh (no ground), as exported and measured."""
+        if self.mitsuba_xml is not None:
+            raise ValueError(f"{self.mitsuba_xml} is a Mitsuba XML scene, rendered as is: it has no "
+                             "separate target mesh to export or measure (export the mesh files its shapes "
+                             "load instead)")
         targets = [p for p in self.parts if p.target]
         if not targets:
             raise ValueError(f"scene {self.name!r} has no target geometry")

@@ -1,4 +1,8 @@
-"""`nbv bench`: run the selected bench areas, write bench.json and bench.md (docs/data-formats.md §8)."""
+"""`nbv bench`: run the selected bench areas, write bench.json and bench.md (docs/data-formats.md §8).
+
+The two files are swapped onto `--out` together once every area has run (`common.io.atomic_folder`):
+an interrupted bench keeps the previous figures whole; other files in `--out` are kept.
+"""
 
 from __future__ import annotations
 
@@ -12,12 +16,14 @@ from typing import Annotated, Literal
 
 from tyro.conf import UseAppendAction
 
-from common.io import markdown_table, write_json, write_text
+from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import git_commit
 from nbv.bench import AREAS, BenchResult
 
 Area = Literal[AREAS]
 """A bench module under `nbv.bench`."""
+OUTPUTS = ("bench.json", "bench.md")
+"""What `nbv bench` writes into `--out` together."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -43,13 +49,12 @@ def run_bench(config: BenchConfig, done: Callable[[str, float], None] | None = N
         results.extend(importlib.import_module(f"nbv.bench.{area}").run(config.quick))
         if done is not None:
             done(area, time.perf_counter() - start)
-    out = Path(config.out)
-    out.mkdir(parents=True, exist_ok=True)
     header = {"machine": platform.processor() or platform.machine(), "commit": git_commit(),
               "time": time.strftime("%Y-%m-%d %H:%M:%S"), "quick": config.quick}
-    write_json(out / "bench.json", {**header, "results": [r.as_dict() for r in results]})
-    write_text(out / "bench.md", f"# Bench ({header['time']}, commit {header['commit']})\n\n"
-                                 f"{format_table(results)}")
+    with atomic_folder(config.out, overwrite=True, outputs=OUTPUTS) as folder:
+        write_text(folder / "bench.md", f"# Bench ({header['time']}, commit {header['commit']})\n\n"
+                                        f"{format_table(results)}")
+        write_json(folder / "bench.json", {**header, "results": [r.as_dict() for r in results]})
     return results
 
 

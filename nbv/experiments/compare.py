@@ -7,6 +7,11 @@ over seeds (docs/rl.md §10). Example (paper_results/planners):
 
     nbv compare alpine_chalet --views 13 --planners policy:runs/policy/checkpoint.pt random circle greedy \\
         --seeds 0 1 2 --out cmp
+
+Each run is its own `nbv plan` output folder, written atomically as it finishes
+(an interrupted comparison keeps the runs done); the comparison files
+(`OUTPUTS`) are swapped onto `--out` together at the end (`common.io.atomic_folder`),
+the run folders carried over as hard links, so they always describe the same runs.
 """
 
 from __future__ import annotations
@@ -17,12 +22,15 @@ from pathlib import Path
 
 import numpy as np
 
-from common.io import write_json
+from common.io import atomic_folder, write_json, write_text
 from common.provenance import config_record, git_commit
 from nbv.experiments.paper_numbers import FIG1_NBV
 from nbv.planning.plan import PlanSettings, plan_scan
 from nbv.planning.planners import planner_label
 from nbv.viz.figures import plot_planner_comparison
+
+OUTPUTS = ("comparison.json", "comparison.md", "comparison.png")
+"""What `nbv compare` writes into `--out` together, beside the run folders."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -71,13 +79,14 @@ def compare_planners(config: CompareConfig) -> str:
                 doc = plan_scan(config.plan_config(planner, seed, folder, overwrite=True))
             runs.append({"planner": label, "seed": seed, **{k: doc[k] for k in ("views", "gt", "reference")}})
     scene = config.scene.scene
-    write_json(out / "comparison.json", {
-        "scene": scene, "seeds": list(config.seeds), "planners": list(config.planners),
-        "commit": git_commit(), "config": config_record(config), "runs": runs, "paper_fig1": FIG1_NBV})
     table = comparison_table(runs, scene, config.metrics.threshold_cm)
-    (out / "comparison.md").write_text(table)
-    plot_planner_comparison(runs, FIG1_NBV, out / "comparison.png",
-                            f"Planners on {Path(scene).name}, {len(config.seeds)} seeds")
+    with atomic_folder(out, overwrite=True, outputs=OUTPUTS) as folder:
+        write_text(folder / "comparison.md", table)
+        plot_planner_comparison(runs, FIG1_NBV, folder / "comparison.png",
+                                f"Planners on {Path(scene).name}, {len(config.seeds)} seeds")
+        write_json(folder / "comparison.json", {
+            "scene": scene, "seeds": list(config.seeds), "planners": list(config.planners),
+            "commit": git_commit(), "config": config_record(config), "runs": runs, "paper_fig1": FIG1_NBV})
     return table
 
 

@@ -5,6 +5,13 @@ changed), Bag of Views refinement (Alg. 1), TSDF fusion of both view sets
 (Sec. V-C), evaluation of both against the ground-truth mesh and of the refined
 set against the full scan (Sec. VI-B), then a table and pictures: contact
 sheet, trajectories, distance heat maps.
+
+Everything but the full scan (`OUTPUTS`) is written into one temporary folder and
+swapped onto `--out` at the end (`common.io.atomic_folder`), so an interrupted demo
+leaves the previous results whole; the cached full scan (`full_scan/`, written
+atomically on its own) is carried over as hard links, not re-rendered. A rescan
+(--fresh, changed settings) stays even if a later stage is interrupted: the
+previous results beside it then record the old scan's settings in results.json.
 """
 
 from __future__ import annotations
@@ -18,7 +25,7 @@ from typing import Any
 
 import trimesh
 
-from common.io import markdown_table, write_json, write_text
+from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import config_record, git_commit
 from nbv.bov.config import BoVConfig
 from nbv.bov.refine import Progress, RefineConfig, refine_dataset
@@ -30,6 +37,12 @@ from nbv.recon.tsdf import Reconstruction, reconstruct_dataset, save_reconstruct
 from nbv.viz.figures import contact_sheet, plot_trajectory
 from render.dataset import ViewDataset, read_dataset
 from scenes.catalog import DEFAULT_SCENE
+from scenes.model import Scene
+
+OUTPUTS = ("refined", "recon_full", "recon_refined", "contact_sheet.png", "trajectory_full.png",
+           "trajectory_refined.png", "heatmap_refined_vs_full.png", "heatmap_refined_vs_full.ply",
+           "heatmap_full_vs_gt.png", "heatmap_full_vs_gt.ply", "results.json", "results.md")
+"""What one demo run writes into `--out`, all together (the cached `full_scan/` beside them is kept)."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -61,25 +74,35 @@ class Stopwatch:
 
 
 def run_demo(config: DemoConfig, progress: Progress | None = None) -> dict[str, Any]:
-    """Run every stage; write `out/results.json` and `out/results.md`; return the results.
+    """Run every stage; write `OUTPUTS` (`results.json`, `results.md`, ...) into `out` together.
 
     `progress` is called with the number of views whose features were just extracted.
     """
     out = Path(config.out)
-    out.mkdir(parents=True, exist_ok=True)
     scene = config.load(config.scene)
     clock = Stopwatch()
     with clock.stage("scan_s"):
         full = config.full_scan(scene, out / "full_scan", config.fresh)
+    with atomic_folder(out, overwrite=True, outputs=OUTPUTS) as folder:
+        results, table = demo_stages(config, scene, full, folder, clock, progress)
+        write_json(folder / "results.json", results)
+        write_text(folder / "results.md", table)
+    return results
+
+
+def demo_stages(config: DemoConfig, scene: Scene, full: ViewDataset, folder: Path, clock: Stopwatch,
+                progress: Progress | None) -> tuple[dict[str, Any], str]:
+    """Refine, reconstruct, evaluate and draw into `folder`; the results and their Markdown table."""
+    out = Path(config.out)
     with clock.stage("refine_s"):
-        refine = RefineConfig(dataset=full.root, out=out / "refined", bov=config.bov, seed=config.seed,
+        refine = RefineConfig(dataset=full.root, out=folder / "refined", bov=config.bov, seed=config.seed,
                               overwrite=True)
         refined = refine_dataset(refine, progress)
     with clock.stage("reconstruct_s"):
         recon_full = reconstruct_dataset(full, config.recon)
         recon_refined = reconstruct_dataset(full, config.recon, refined["kept"])
-        save_reconstruction(recon_full, out / "recon_full")
-        save_reconstruction(recon_refined, out / "recon_refined")
+        save_reconstruction(recon_full, folder / "recon_full")
+        save_reconstruction(recon_refined, folder / "recon_refined")
     gt = scene.target_mesh()
     with clock.stage("evaluate_s"):
         metrics_config = config.seeded_metrics
@@ -89,7 +112,7 @@ def run_demo(config: DemoConfig, progress: Progress | None = None) -> dict[str, 
                                          metrics_config),
         }
     with clock.stage("figures_s"):
-        figures = draw_figures(config, scene.name, full, recon_full, recon_refined, gt)
+        figures = draw_figures(config, scene.name, full, recon_full, recon_refined, gt, folder)
     results = {
         "config": config_record(config),
         "commit": git_commit(),
@@ -99,17 +122,14 @@ def run_demo(config: DemoConfig, progress: Progress | None = None) -> dict[str, 
         "kept": refined["kept"],
         "metrics": {name: {ref: m.as_dict() for ref, m in per.items()} for name, per in metrics.items()},
         "timings": clock.seconds,
-        "figures": {k: str(v) for k, v in figures.items()},
+        "figures": {k: str(out / Path(v).name) for k, v in figures.items()},
     }
-    write_json(out / "results.json", results)
-    write_text(out / "results.md", results_table(results, metrics))
-    return results
+    return results, results_table(results, metrics)
 
 
 def draw_figures(config: DemoConfig, name: str, full: ViewDataset, recon_full: Reconstruction,
-                 recon_refined: Reconstruction, gt: trimesh.Trimesh) -> dict[str, Path]:
-    """The demo's pictures: contact sheet, both trajectories, both heat maps."""
-    out = Path(config.out)
+                 recon_refined: Reconstruction, gt: trimesh.Trimesh, out: Path) -> dict[str, Path]:
+    """The demo's pictures, written into `out`: contact sheet, both trajectories, both heat maps."""
     size = f"N={config.bov.ranges}, W={config.bov.words}"
     return {
         "contact_sheet": contact_sheet(full, out / "contact_sheet.png"),

@@ -7,6 +7,12 @@ reconstructed and compared with the reference (the paper's Hausdorff and
 Chamfer) and with the ground-truth mesh (which the paper did not have).
 Every number written here comes from this run; the paper's stand in their own
 labelled columns.
+
+The Fig. 6 heat maps are drawn into a scratch folder while measuring; at the end
+the tables, the chart and `fig6/` (`OUTPUTS`) are swapped onto `--out` together
+(`common.io.atomic_folder`): an interrupted run keeps the previous results whole,
+and what else `--out` holds (e.g. `paper_results/planners/`) is carried over,
+only in the last seconds, so a run writing there meanwhile is not lost.
 """
 
 from __future__ import annotations
@@ -16,7 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from common.io import markdown_table, write_json, write_text
+from common.io import atomic_folder, markdown_table, scratch_folder, write_json, write_text
 from common.provenance import config_record, git_commit
 from nbv.bov.config import BoVRule
 from nbv.bov.refine import DatasetRun, Progress, kept_view_grid, load_views
@@ -33,6 +39,8 @@ COLUMNS = {"ranges": "N", "words": "W", "views": "views", "paper_views": "paper 
            "ref_chamfer_cm": "Chamfer ref", "paper_chamfer_cm": "paper Chamfer", "gt_coverage": "coverage gt",
            "gt_chamfer_cm": "Chamfer gt"}
 """Row key -> column title of table2.md, after the building."""
+OUTPUTS = ("table2.json", "table2.csv", "table2.md", "table2.png", "fig6")
+"""What `nbv tables` writes into `--out`, all together (other entries there are kept)."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -66,10 +74,11 @@ def _corners(config: TablesConfig) -> set[tuple[int, int]]:
             for w in (min(config.words), max(config.words))}
 
 
-def measure_scene(name: str, config: TablesConfig, progress: Progress | None = None) -> list[dict[str, Any]]:
+def measure_scene(name: str, config: TablesConfig, progress: Progress | None = None,
+                  fig6: Path | None = None) -> list[dict[str, Any]]:
     """Table 2 rows of one building: the full scan against ground truth, then one row per (N, W).
 
-    Writes the Fig. 6 heat maps of the grid's corner cells into `config.out/fig6`.
+    Writes the Fig. 6 heat maps of the grid's corner cells into `fig6` (default `config.out/fig6`).
     `progress` is called once per row measured.
     """
     scene = config.load(name)
@@ -94,8 +103,8 @@ def measure_scene(name: str, config: TablesConfig, progress: Progress | None = N
                      "paper_chamfer_cm": paper.get("chamfer_cm"), **_prefixed("gt", m["gt"].as_dict())})
         if (n, w) in _corners(config):
             title = f"{name}: N={n}, W={w}, {len(result.kept)} views vs the {len(full)}-view scan"
-            write_heatmap(recon, reference, Path(config.out) / "fig6", name=f"fig6_{name}_N{n}_W{w}",
-                          title=title)
+            write_heatmap(recon, reference, Path(config.out) / "fig6" if fig6 is None else fig6,
+                          name=f"fig6_{name}_N{n}_W{w}", title=title)
         _tick(progress)
     return rows
 
@@ -116,15 +125,17 @@ def run_tables(config: TablesConfig, progress: Progress | None = None) -> list[d
     `progress` is called once per row measured: 1 + len(ranges) * len(words) per scene.
     """
     out = Path(config.out)
-    out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
-    rows = [row for name in config.scenes for row in measure_scene(name, config, progress)]
-    header = {"command": f"make tables  (nbv tables --out {out})", "commit": git_commit(),
-              "seconds": round(time.perf_counter() - start, 1), "config": config_record(config)}
-    write_json(out / "table2.json", {**header, "rows": rows})
-    write_csv(out / "table2.csv", rows, fieldnames=list(rows[-1]))
-    write_text(out / "table2.md", table2_markdown(rows, header))
-    plot_table2(rows, out / "table2.png")
+    with scratch_folder(out) as fig6:
+        rows = [row for name in config.scenes for row in measure_scene(name, config, progress, fig6)]
+        header = {"command": f"make tables  (nbv tables --out {out})", "commit": git_commit(),
+                  "seconds": round(time.perf_counter() - start, 1), "config": config_record(config)}
+        with atomic_folder(out, overwrite=True, outputs=OUTPUTS) as folder:
+            fig6.rename(folder / "fig6")
+            write_csv(folder / "table2.csv", rows, fieldnames=list(rows[-1]))
+            write_text(folder / "table2.md", table2_markdown(rows, header))
+            plot_table2(rows, folder / "table2.png")
+            write_json(folder / "table2.json", {**header, "rows": rows})
     return rows
 
 

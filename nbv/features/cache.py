@@ -23,6 +23,7 @@ import torch
 from common.io import atomic_path, cache_dir
 from nbv.features.sift import DESCRIPTOR_DIM, FeatureConfig, Features, extract_features
 from render.dataset import ViewDataset
+from render.dataset_read import image_bytes
 
 CACHE_VERSION = 1
 
@@ -33,10 +34,12 @@ def default_cache_dir() -> Path:
 
 
 def dataset_digest(dataset: ViewDataset) -> str:
-    """SHA-256 over the bytes of the dataset's images, in frame order."""
+    """SHA-256 over the bytes of the dataset's images, in frame order; each file is read through the
+    reader's size check (`image_bytes`), so a huge file is refused before it is read."""
     digest = hashlib.sha256()
+    width, height = dataset.camera.width, dataset.camera.height
     for frame in dataset.frames:
-        digest.update(frame.rgb_path.read_bytes())
+        digest.update(image_bytes(frame.rgb_path, width, height))
         digest.update(b"\0")
     return digest.hexdigest()
 

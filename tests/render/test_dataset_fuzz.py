@@ -90,6 +90,7 @@ def _deep(depth: int) -> str:
 PROBE_CASES = {
     "D1_nbv_not_object": (_set("nbv", None), "field nbv must be an object"),
     "D2_frame_nbv_none": (_set("frames.1.nbv", None), r"frames\[1\]\.nbv must be an object"),
+    "frames_empty": (_set("frames", []), "field frames is empty"),
     "D2_frame_nbv_list": (_set("frames.1.nbv", ["a"]), r"frames\[1\]\.nbv must be an object"),
     "D3_w_beyond_float": (_set("w", 10**400), "field w must lie in"),
     "D3_fl_x_beyond_float": (_set("fl_x", 10**400), "field fl_x is too large"),

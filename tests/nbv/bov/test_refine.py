@@ -16,8 +16,7 @@ from synthetic import write_circle_dataset
 from nbv.bov.config import BoVConfig
 from nbv.bov.refine import RefineConfig, frame_azimuths, refine_dataset, refine_views
 from nbv.cli import main
-from render.camera import UAVCamera
-from render.dataset import DatasetError, DatasetWriter, read_dataset
+from render.dataset import DatasetError, read_dataset
 
 E = torch.eye(4)
 SMALL = ["--max-features", "40"]
@@ -108,11 +107,11 @@ def test_dataset_without_images(tmp_path):
     (broken / "images" / "0001.png").unlink()
     with pytest.raises(DatasetError, match="missing file"):
         refine_dataset(RefineConfig(dataset=broken, out=tmp_path / "out", cache_dir=tmp_path / "cache"))
-    with DatasetWriter(tmp_path / "empty", UAVCamera(32, 24), {}):
-        pass
-    with pytest.raises(ValueError, match="no frames"):
-        refine_dataset(RefineConfig(dataset=tmp_path / "empty", out=tmp_path / "out",
-                                    cache_dir=tmp_path / "cache"))
+    empty = write_circle_dataset(tmp_path / "empty", [0])
+    doc = json.loads((empty / "transforms.json").read_text())
+    (empty / "transforms.json").write_text(json.dumps({**doc, "frames": []}))
+    with pytest.raises(DatasetError, match="transforms.json: field frames is empty"):
+        refine_dataset(RefineConfig(dataset=empty, out=tmp_path / "out", cache_dir=tmp_path / "cache"))
 
 
 def test_refuses_to_overwrite(source, tmp_path):

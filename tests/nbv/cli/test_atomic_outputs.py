@@ -252,3 +252,139 @@ def test_refine_sweep_writes_its_three_files_together(tmp_path, monkeypatch):
     with pytest.raises(KeyboardInterrupt):
         main([*args[:-4], "--words", "7", *args[-4:]])
     assert snapshot(out) == before and leftovers(out) == []
+
+
+def test_bench_interrupted_keeps_the_previous_figures(tmp_path, monkeypatch):
+    from types import SimpleNamespace
+
+    from nbv.bench import BenchResult, suite
+
+    class Area:
+        value = 1.0
+
+        def run(self, quick: bool) -> list[BenchResult]:
+            return [BenchResult("fake", "figure", self.value, "s")]
+
+    area = Area()
+    monkeypatch.setattr(suite, "importlib", SimpleNamespace(import_module=lambda name: area))
+    out = tmp_path / "bench"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    suite.run_bench(suite.BenchConfig(out=out, area=("cli",)))
+    before = snapshot(out)
+    assert set(before) == {"bench.json", "bench.md", "notes.txt"}
+    area.value = 2.0
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt  # bench.md written, bench.json not yet
+
+    monkeypatch.setattr(suite, "write_json", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        suite.run_bench(suite.BenchConfig(out=out, area=("cli",)))
+    assert snapshot(out) == before and leftovers(out) == []
+
+
+def test_compare_interrupted_keeps_the_previous_comparison_and_the_runs(tmp_path, monkeypatch):
+    from nbv.experiments.compare import CompareConfig, compare_planners
+    from scenes.spec import SceneSpec
+
+    metrics = {"coverage": 0.7, "chamfer_cm": 0.5, "hausdorff_cm": 8.0}
+    out = tmp_path / "cmp"
+    for seed in (0, 1):
+        (out / f"random-seed{seed}").mkdir(parents=True)
+        (out / f"random-seed{seed}" / "plan.json").write_text(
+            json.dumps({"views": 13, "gt": metrics, "reference": metrics}))
+    monkeypatch.setattr("nbv.experiments.compare.plot_planner_comparison",
+                        lambda runs, paper, path, title: Path(path).write_bytes(b"png"))
+    config = CompareConfig(scene=SceneSpec(scene="alpine_chalet"), planners=("random",), seeds=(0,), out=out)
+    compare_planners(config)
+    before = snapshot(out)
+    assert {"comparison.json", "comparison.md", "comparison.png", "random-seed1/plan.json"} <= set(before)
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt  # table and chart written, comparison.json not yet
+
+    monkeypatch.setattr("nbv.experiments.compare.write_json", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        compare_planners(CompareConfig(scene=SceneSpec(scene="alpine_chalet"), planners=("random",),
+                                       seeds=(0, 1), out=out))
+    assert snapshot(out) == before and leftovers(out) == []
+
+
+def test_tables_interrupted_keeps_the_previous_tables_and_fig6(tmp_path, monkeypatch):
+    from nbv.experiments.table2 import TablesConfig, run_tables
+
+    grid = {"n": 5}
+
+    def measure(name, config, progress=None, fig6=None):
+        Path(fig6).mkdir(exist_ok=True)
+        (Path(fig6) / f"fig6_{name}_N{grid['n']}.png").write_bytes(b"png")
+        return [{"scene": name, "ranges": grid["n"], "words": 10, "views": 3}]
+
+    monkeypatch.setattr("nbv.experiments.table2.measure_scene", measure)
+    monkeypatch.setattr("nbv.experiments.table2.plot_table2",
+                        lambda rows, path: Path(path).write_bytes(b"png"))
+    out = tmp_path / "paper_results"
+    (out / "planners").mkdir(parents=True)
+    (out / "planners" / "comparison.md").write_text("another command's result")
+    run_tables(TablesConfig(out=out, scenes=("test_building",)))
+    before = snapshot(out)
+    assert {"table2.json", "table2.csv", "table2.md", "table2.png", "fig6/fig6_test_building_N5.png",
+            "planners/comparison.md"} == set(before)
+    grid["n"] = 7
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt  # fig6, csv, md and png in place, table2.json not yet
+
+    monkeypatch.setattr("nbv.experiments.table2.write_json", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        run_tables(TablesConfig(out=out, scenes=("test_building",)))
+    assert snapshot(out) == before and leftovers(out) == []
+
+
+def test_demo_interrupted_keeps_the_previous_results_and_the_cached_scan(tmp_path, monkeypatch):
+    from nbv.experiments import demo
+    from nbv.experiments.study import FullScanStudy
+
+    out = tmp_path / "demo"
+
+    def full_scan(self, scene, folder, fresh):
+        if not folder.is_dir():
+            folder.mkdir(parents=True)
+            (folder / "transforms.json").write_text("{}")
+        return folder
+
+    def stages(config, scene, full, folder, clock, progress):
+        (folder / "refined").mkdir()
+        (folder / "refined" / "refine.json").write_text(json.dumps(config.seed))
+        return {"seed": config.seed}, f"seed {config.seed}\n"
+
+    monkeypatch.setattr(FullScanStudy, "load", lambda self, name: name)
+    monkeypatch.setattr(FullScanStudy, "full_scan", full_scan)
+    monkeypatch.setattr(demo, "demo_stages", stages)
+    demo.run_demo(demo.DemoConfig(out=out, seed=1))
+    before = snapshot(out)
+    assert set(before) == {"full_scan/transforms.json", "refined/refine.json", "results.json", "results.md"}
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt  # every stage done, results.json not yet
+
+    monkeypatch.setattr(demo, "write_json", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        demo.run_demo(demo.DemoConfig(out=out, seed=2))
+    assert snapshot(out) == before and leftovers(out) == []
+
+
+def test_unwritable_out_is_one_line_naming_it(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    blocker.chmod(0o755)  # root may write anything; a file is still no folder
+    out = blocker / "sub" / "export"
+    assert main(["scene", "export", "test_building", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and str(out) in err and "not a folder" in err, err
+    assert ".tmp-" not in err
+    if Path("/proc/self").is_dir():  # /proc passes the up-front checks; mkdtemp's own error is named too
+        assert main(["scene", "export", "test_building", "--out", "/proc/nbv-x"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and "output folder /proc/nbv-x " in err and ".tmp-" not in err, err

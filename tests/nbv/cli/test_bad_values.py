@@ -7,6 +7,7 @@ import json
 
 import pytest
 import torch
+from synthetic import write_circle_dataset
 
 from nbv.cli import main
 from nbv.rl.checkpoint import FORMAT, REQUIRED, VERSION
@@ -24,6 +25,9 @@ CASES = [
     (SCAN + ["--radius", "1e308"], "radius"),
     (SCAN + ["--radius", "1e-9"], "radius"),
     (SCAN + ["--radius", "0.5"], "radius"),
+    (SCAN + ["--plan", "circle", "--views", "10000000"], "views"),
+    (SCAN + ["--plan", "circle", "--end-overlap", "0.99999999"], "end_overlap"),
+    (SCAN + ["--end-overlap", "0.99999999"], "end_overlap"),
     (PLAN + ["--views", "0"], "views"),
     (TRAIN + ["--gamma", "2"], "gamma"),
     (TRAIN + ["--gamma", "0"], "gamma"),
@@ -91,3 +95,13 @@ def test_hostile_checkpoint_config_is_a_checkpoint_error(case, tmp_path, capsys)
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and str(path) in err, err
     assert not (tmp_path / "p").exists()
+
+
+def test_dataset_without_frames_names_the_file_and_field(tmp_path, capsys):
+    source = write_circle_dataset(tmp_path / "ds", [0, 1], size=(32, 24))
+    doc = json.loads((source / "transforms.json").read_text())
+    (source / "transforms.json").write_text(json.dumps({**doc, "frames": []}))
+    assert main(["reconstruct", str(source), "--out", str(tmp_path / "rec")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "transforms.json: field frames is empty" in err, err
+    assert not (tmp_path / "rec").exists()

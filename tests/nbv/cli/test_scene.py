@@ -26,6 +26,15 @@ def test_export_writes_the_target_mesh(tmp_path):
     assert np.allclose(mesh.bounds, expected.bounds, atol=1e-6)
 
 
+def test_export_of_a_mitsuba_xml_scene_says_it_has_no_separate_target_mesh(tmp_path, capsys):
+    xml = tmp_path / "scene.xml"
+    xml.write_text('<scene version="3.0.0"><shape type="sphere"/></scene>')
+    assert main(["scene", "export", str(xml), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and f"{xml} is a Mitsuba XML scene" in err, err
+    assert "no separate target mesh to export" in err and not (tmp_path / "out").exists()
+
+
 def test_export_refuses_to_replace_a_mesh_without_overwrite(tmp_path, capsys):
     assert main(["scene", "export", "test_building", "--out", str(tmp_path)]) == 0
     (tmp_path / "mesh.ply").write_text("mine")

@@ -11,6 +11,7 @@ import nbv.features.cache as fc
 from nbv.features.sift import FeatureConfig
 from render.camera import UAVCamera
 from render.dataset import DatasetWriter, read_dataset
+from render.dataset_read import DatasetError
 
 CONFIG = FeatureConfig(max_features=40)
 
@@ -70,12 +71,24 @@ def test_cache_of_wrong_shape_is_rebuilt(dataset, tmp_path):
 
 
 def test_dataset_without_frames(tmp_path):
-    with DatasetWriter(tmp_path / "empty", UAVCamera(32, 24), {}):
+    with pytest.raises(ValueError, match="no frames were added"), DatasetWriter(tmp_path / "empty",
+                                                                               UAVCamera(32, 24), {}):
         pass
-    with pytest.raises(ValueError, match="no frames"):
-        fc.dataset_features(read_dataset(tmp_path / "empty"), CONFIG, tmp_path / "cache")
+    assert not (tmp_path / "empty").exists()
 
 
 def test_default_cache_dir_follows_env(monkeypatch, tmp_path):
     monkeypatch.setenv("NBV_CACHE_DIR", str(tmp_path))
     assert fc.default_cache_dir() == tmp_path / "features"
+
+
+def test_digest_refuses_a_huge_image_file_unread(dataset, monkeypatch):
+    with open(dataset.frames[1].rgb_path, "r+b") as handle:
+        handle.truncate(2**40)  # sparse: a terabyte on paper, nothing on disk
+
+    def unbounded(self, *args, **kwargs):
+        raise AssertionError("read whole")
+
+    monkeypatch.setattr("pathlib.Path.read_bytes", unbounded)
+    with pytest.raises(DatasetError, match=r"0001\.png: file larger than"):
+        fc.dataset_digest(dataset)

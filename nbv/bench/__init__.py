@@ -18,6 +18,7 @@ AREAS = (
     "scenes",
     "bov",
     "recon",
+    "threads",
     "rl",
 )
 """Bench modules under `nbv.bench`, run in this order."""
@@ -28,7 +29,7 @@ class BenchResult:
     """One measured figure."""
 
     area: str
-    """The bench module that measured it (cli, render, scenes, bov, recon, rl)."""
+    """The bench module that measured it (cli, render, scenes, bov, recon, threads, rl)."""
     name: str
     """What was measured, with its settings (e.g. 'RGB-D views/s llvm_ad_rgb 320x240 steady')."""
     value: float

@@ -225,6 +225,9 @@ class BagOfViews(nn.Module):
         dim: descriptor dimension D (128 for SIFT).
         kmeans_iters: maximum Lloyd rounds per update.
         match_cosine: c of d = 1 - cos / c (0.5: the paper's Eq. 1 to the letter).
+        bands: elevation bands E per azimuth range (1: the paper's azimuth-only ranges); the
+            vocabularies then number N x E, view (phi, theta) filling azimuth range i's band j.
+        elevation_bounds: (low, high) radians split into the E bands (needed when E > 1).
 
     Example:
         >>> bov = BagOfViews(ranges=2, words=1, dim=4, match_cosine=0.5)
@@ -238,15 +241,22 @@ class BagOfViews(nn.Module):
 
     def __init__(self, ranges: int, words: int, memory_cap: int = 2048, seed: int = 0,
                  device: str | torch.device | None = None, dim: int = 128, kmeans_iters: int = 10,
-                 match_cosine: float = DEFAULT_MATCH_COSINE) -> None:
+                 match_cosine: float = DEFAULT_MATCH_COSINE, bands: int = 1,
+                 elevation_bounds: tuple[float, float] | None = None) -> None:
         super().__init__()
         dissimilarity(torch.zeros(()), match_cosine)  # validates c
-        checks = (("ranges", ranges), ("words", words), ("dim", dim), ("kmeans_iters", kmeans_iters))
+        checks = (("ranges", ranges), ("words", words), ("dim", dim), ("kmeans_iters", kmeans_iters),
+                  ("bands", bands))
         for name, value in checks:
             if value < 1:
                 raise ValueError(f"{name} must be >= 1, got {value}")
         if memory_cap < words:
             raise ValueError(f"memory_cap ({memory_cap}) must be >= words ({words})")
+        if bands > 1 and not (elevation_bounds and elevation_bounds[0] < elevation_bounds[1]):
+            raise ValueError(f"{bands} elevation bands need elevation_bounds (low < high), "
+                             f"got {elevation_bounds}")
+        self.azimuth_ranges, self.bands, self.elevation_bounds = ranges, bands, elevation_bounds
+        ranges *= bands
         self.ranges, self.num_words, self.memory_cap = ranges, words, memory_cap
         self.seed, self.dim, self.kmeans_iters = seed, dim, kmeans_iters
         self.match_cosine = match_cosine
@@ -258,19 +268,26 @@ class BagOfViews(nn.Module):
         self.register_buffer("updates", torch.zeros(ranges, dtype=torch.long, device=device))
 
     def extra_repr(self) -> str:
-        return (f"ranges={self.ranges}, words={self.num_words}, memory_cap={self.memory_cap}, "
-                f"dim={self.dim}, match_cosine={self.match_cosine}")
+        return (f"ranges={self.azimuth_ranges}, bands={self.bands}, words={self.num_words}, "
+                f"memory_cap={self.memory_cap}, dim={self.dim}, match_cosine={self.match_cosine}")
 
     @property
     def word_mask(self) -> torch.Tensor:
         """(N, W) True where a vocabulary holds a word."""
         return torch.arange(self.num_words, device=self.words.device) < self.word_count[:, None]
 
-    def range_of(self, azimuth: float) -> int:
-        """Alg. 1 line 4: id = floor(phi / (2pi / N)), phi wrapped to [0, 2pi)."""
-        if not math.isfinite(azimuth):
-            raise ValueError(f"azimuth must be finite, got {azimuth}")
-        return min(int((azimuth % TWO_PI) / (TWO_PI / self.ranges)), self.ranges - 1)
+    def range_of(self, azimuth: float, elevation: float = 0.0) -> int:
+        """Alg. 1 line 4: id = floor(phi / (2pi / N)), phi wrapped to [0, 2pi); with E bands,
+        id * E + the band of the elevation (clamped to the bounds)."""
+        if not (math.isfinite(azimuth) and math.isfinite(elevation)):
+            raise ValueError(f"azimuth and elevation must be finite, got {azimuth}, {elevation}")
+        n = self.azimuth_ranges
+        r = min(int((azimuth % TWO_PI) / (TWO_PI / n)), n - 1)
+        if self.bands == 1:
+            return r
+        low, high = self.elevation_bounds
+        band = int((elevation - low) / (high - low) * self.bands)
+        return r * self.bands + min(max(band, 0), self.bands - 1)
 
     def forward(self, descriptors: torch.Tensor, mask: torch.Tensor, range_ids: torch.Tensor) -> torch.Tensor:
         """Scores of a padded batch of views against their ranges' vocabularies (no update).
@@ -282,14 +299,14 @@ class BagOfViews(nn.Module):
         words, word_mask = self.words[range_ids], self.word_mask[range_ids]
         return view_score(descriptors, words, mask, word_mask, self.match_cosine)
 
-    def score(self, descriptors: torch.Tensor | np.ndarray, azimuth: float) -> float:
+    def score(self, descriptors: torch.Tensor | np.ndarray, azimuth: float, elevation: float = 0.0) -> float:
         """Alg. 1 score of one view: +inf for an empty range, 0 for no descriptors.
 
         Shape:
             - descriptors: :math:`(M, D)`.
         """
         x = check_descriptors(descriptors, self.dim, self.words.device)
-        r = self.range_of(azimuth)
+        r = self.range_of(azimuth, elevation)
         k = int(self.word_count[r])
         if x.shape[0] == 0 or k == 0:  # docs/bov.md §3: no keypoints -> 0; empty vocabulary -> +inf
             return 0.0 if x.shape[0] == 0 else math.inf
@@ -328,7 +345,7 @@ class BagOfViews(nn.Module):
         self.seen[r] += m
         self.memory_count[r] = min(cap, int(self.seen[r]))
 
-    def update(self, descriptors: torch.Tensor | np.ndarray, azimuth: float) -> None:
+    def update(self, descriptors: torch.Tensor | np.ndarray, azimuth: float, elevation: float = 0.0) -> None:
         """Alg. 1 lines 11-12: add the view's descriptors to its range and re-cluster the words.
 
         A view with no descriptors changes nothing.
@@ -339,7 +356,7 @@ class BagOfViews(nn.Module):
         x = check_descriptors(descriptors, self.dim, self.words.device)
         if x.shape[0] == 0:
             return
-        r = self.range_of(azimuth)
+        r = self.range_of(azimuth, elevation)
         generator = self._generator(r)
         self._remember(r, F.normalize(x, dim=1), generator)
         held = int(self.memory_count[r])
@@ -350,15 +367,15 @@ class BagOfViews(nn.Module):
         self.word_count[r] = k
         self.updates[r] += 1
 
-    def reward(self, descriptors: torch.Tensor | np.ndarray, azimuth: float) -> float:
+    def reward(self, descriptors: torch.Tensor | np.ndarray, azimuth: float, elevation: float = 0.0) -> float:
         """Paper Sec. IV: update the view's range, return dist(new vocabulary, old) - 1.
 
         Shape:
             - descriptors: :math:`(M, D)`.
         """
-        r = self.range_of(azimuth)
+        r = self.range_of(azimuth, elevation)
         old, old_mask = self.words[r].clone(), self.word_mask[r].clone()
-        self.update(descriptors, azimuth)
+        self.update(descriptors, azimuth, elevation)
         return float(bov_reward(self.words[r], old, self.word_mask[r], old_mask, self.match_cosine))
 
     def reset(self) -> None:

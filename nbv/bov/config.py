@@ -52,12 +52,14 @@ class BoVRule:
 
         return FeatureConfig(backend=self.features, max_features=self.max_features, device=device)
 
-    def make_bag(self, ranges: int, words: int, seed: int = 0, device: str = "cpu") -> BagOfViews:
-        """An empty Bag of Views of N = `ranges` vocabularies of W = `words` words under this rule."""
+    def make_bag(self, ranges: int, words: int, seed: int = 0, device: str = "cpu", bands: int = 1,
+                 elevation_bounds: tuple[float, float] | None = None) -> BagOfViews:
+        """An empty Bag of Views of N = `ranges` (x E = `bands`) vocabularies of W = `words` words."""
         from nbv.bov.bag import BagOfViews
 
         return BagOfViews(ranges, words, self.memory_cap, seed=seed, device=device,
-                          kmeans_iters=self.kmeans_iters, match_cosine=self.match_cosine)
+                          kmeans_iters=self.kmeans_iters, match_cosine=self.match_cosine, bands=bands,
+                          elevation_bounds=elevation_bounds)
 
 
 def check_size(ranges: int, words: int) -> None:
@@ -75,11 +77,17 @@ class BoVConfig(BoVRule):
     """N, azimuth ranges (vocabularies) of the Bag of Views."""
     words: Annotated[int, arg(aliases=("--bov-words",))] = 20
     """W, visual words per range."""
+    elevation_bands: int = 1
+    """E, elevation bands per azimuth range of the online reward (1: the paper's azimuth-only ranges; 2
+    tells a high view from a low one). Beyond the paper; offline refinement (Alg. 1) uses azimuth only."""
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        check_size(self.ranges, self.words)
+        if self.elevation_bands < 1:
+            raise ValueError(f"elevation_bands must be >= 1, got {self.elevation_bands}")
+        check_size(self.ranges * self.elevation_bands, self.words)
 
-    def bag(self, seed: int = 0, device: str = "cpu") -> BagOfViews:
-        """An empty Bag of Views of this size."""
-        return self.make_bag(self.ranges, self.words, seed, device)
+    def bag(self, seed: int = 0, device: str = "cpu",
+            elevation_bounds: tuple[float, float] | None = None) -> BagOfViews:
+        """An empty Bag of Views of this size (`elevation_bounds`, radians, split into the E bands)."""
+        return self.make_bag(self.ranges, self.words, seed, device, self.elevation_bands, elevation_bounds)

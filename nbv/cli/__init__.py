@@ -30,6 +30,7 @@ COMMANDS = {
     "train": Command("train", "train the SAC next-best-view policy (resumes a run folder)"),
     "plan": Command("plan", "plan a scan with a planner, reconstruct it and score it"),
     "compare": Command("compare", "compare planners over seeds on one scene (table and bar chart)"),
+    "online": Command("online", "the shipped policy against the baselines on held-out buildings"),
     "plot-training": Command("plot_training", "overlay the learning curves of training runs"),
     "demo": Command("demo", "scan, refine, reconstruct and evaluate a built-in scene"),
     "tables": Command("tables", "reproduce the paper's Table 2 and Fig. 6"),

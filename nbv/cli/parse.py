@@ -29,7 +29,9 @@ def _refused_value(event: ParseErrorEvent) -> None:
         raise ValueError(event.message)
 
 
-def parse(cls: type[T], args: Sequence[str], prog: str, default: T | None = None) -> T:
+def parse(cls: type[T], args: Sequence[str], prog: str, default: T | None = None,
+          description: str | None = None) -> T:
     """The config `cls` from command-line `args` (`--help` prints the options and exits)."""
     with on_parse_error(_refused_value):
-        return tyro.cli(cls, args=list(args), prog=prog, default=default, config=MARKERS)
+        return tyro.cli(cls, args=list(args), prog=prog, default=default, description=description,
+                        config=MARKERS)

@@ -49,6 +49,8 @@ class CompareConfig(PlanSettings):
     def __post_init__(self) -> None:
         if not self.planners or not self.seeds:
             raise ValueError("a comparison needs at least one planner and one seed")
+        if not self.full_scan:
+            raise ValueError("a comparison scores against the full scan too: leave out --no-full-scan")
 
 
 COMPARED = (("coverage", "reference", 100.0, "coverage % (ref)"),
@@ -77,7 +79,8 @@ def compare_planners(config: CompareConfig) -> str:
                 doc = json.loads((folder / "plan.json").read_text())
             else:
                 doc = plan_scan(config.plan_config(planner, seed, folder, overwrite=True))
-            runs.append({"planner": label, "seed": seed, **{k: doc[k] for k in ("views", "gt", "reference")}})
+            runs.append({"planner": label, "seed": seed,
+                         **{k: doc[k] for k in ("views", "gt", "reference", "planning_s", "deciding_s")}})
     scene = config.scene.scene
     table = comparison_table(runs, scene, config.metrics.threshold_cm)
     with atomic_folder(out, overwrite=True, outputs=OUTPUTS) as folder:

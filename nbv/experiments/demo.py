@@ -4,7 +4,10 @@ Stages: the full hemisphere scan (paper Sec. V-B; reused while nothing
 changed), Bag of Views refinement (Alg. 1), TSDF fusion of both view sets
 (Sec. V-C), evaluation of both against the ground-truth mesh and of the refined
 set against the full scan (Sec. VI-B), then a table and pictures: contact
-sheet, trajectories, distance heat maps.
+sheet, trajectories, distance heat maps. The online half (paper Sec. IV-VI-A)
+follows: the shipped policy plans one pass around a held-out building
+(`online_scene`), its views are captured, fused and scored against the ground
+truth beside random views at the same count (`nbv plan` runs, `online_*/`).
 
 Everything but the full scan (`OUTPUTS`) is written into one temporary folder and
 swapped onto `--out` at the end (`common.io.atomic_folder`), so an interrupted demo
@@ -29,8 +32,9 @@ from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import config_record, git_commit
 from nbv.bov.config import BoVConfig
 from nbv.bov.refine import Progress, RefineConfig, refine_dataset
-from nbv.experiments.paper_numbers import FULL_SCAN_VIEWS, SEC7_SUMMARY, TABLE2
+from nbv.experiments.paper_numbers import FIG7_GENERALISATION, FULL_SCAN_VIEWS, SEC7_SUMMARY, TABLE2
 from nbv.experiments.study import FullScanStudy
+from nbv.planning.plan import PlanConfig, plan_scan
 from nbv.recon.heatmap import write_heatmap
 from nbv.recon.metrics import SurfaceMetrics, evaluate_surfaces
 from nbv.recon.tsdf import Reconstruction, reconstruct_dataset, save_reconstruction
@@ -38,10 +42,12 @@ from nbv.viz.figures import contact_sheet, plot_trajectory
 from render.dataset import ViewDataset, read_dataset
 from scenes.catalog import DEFAULT_SCENE
 from scenes.model import Scene
+from scenes.spec import SceneSpec
 
 OUTPUTS = ("refined", "recon_full", "recon_refined", "contact_sheet.png", "trajectory_full.png",
            "trajectory_refined.png", "heatmap_refined_vs_full.png", "heatmap_refined_vs_full.ply",
-           "heatmap_full_vs_gt.png", "heatmap_full_vs_gt.ply", "results.json", "results.md")
+           "heatmap_full_vs_gt.png", "heatmap_full_vs_gt.ply", "results.json", "results.md", "online_policy",
+           "online_random")
 """What one demo run writes into `--out`, all together (the cached `full_scan/` beside them is kept)."""
 
 
@@ -57,6 +63,12 @@ class DemoConfig(FullScanStudy):
     """The Bag of Views of the refinement."""
     fresh: bool = False
     """Rescan even if the output folder already holds a full scan made with these settings."""
+    online: bool = True
+    """Run the online half: a policy plans a held-out building, beside random views."""
+    online_scene: str = "alpine_chalet"
+    """The held-out building of the online half (never trained on)."""
+    policy: str = "policy"
+    """The online half's planner: the shipped policy, or policy:CHECKPOINT."""
 
 
 class Stopwatch:
@@ -113,6 +125,10 @@ def demo_stages(config: DemoConfig, scene: Scene, full: ViewDataset, folder: Pat
         }
     with clock.stage("figures_s"):
         figures = draw_figures(config, scene.name, full, recon_full, recon_refined, gt, folder)
+    online = {}
+    if config.online:
+        with clock.stage("online_s"):
+            online = online_half(config, folder)
     results = {
         "config": config_record(config),
         "commit": git_commit(),
@@ -123,8 +139,21 @@ def demo_stages(config: DemoConfig, scene: Scene, full: ViewDataset, folder: Pat
         "metrics": {name: {ref: m.as_dict() for ref, m in per.items()} for name, per in metrics.items()},
         "timings": clock.seconds,
         "figures": {k: str(out / Path(v).name) for k, v in figures.items()},
+        "online": online,
     }
     return results, results_table(results, metrics)
+
+
+def online_half(config: DemoConfig, folder: Path) -> dict[str, dict[str, Any]]:
+    """The policy's one pass around `online_scene`, then random views at its count: `nbv plan` runs."""
+    spec = SceneSpec(scene=config.online_scene, up_axis=config.up_axis)
+    shared = {"scene": spec, "camera": config.camera, "render": config.render, "recon": config.recon,
+              "metrics": config.metrics, "full_scan": False, "seed": config.seed, "overwrite": True}
+    policy = plan_scan(PlanConfig(**shared, planner=config.policy, out=folder / "online_policy"))
+    rand = plan_scan(PlanConfig(**shared, planner="random", views=policy["views"],
+                                out=folder / "online_random"))
+    keep = ("views", "planning_s", "gt")
+    return {"policy": {k: policy[k] for k in keep}, "random": {k: rand[k] for k in keep}}
 
 
 def draw_figures(config: DemoConfig, name: str, full: ViewDataset, recon_full: Reconstruction,
@@ -172,4 +201,16 @@ def results_table(results: dict[str, Any], metrics: dict[str, dict[str, SurfaceM
         "Timings (s): " + ", ".join(f"{k} {v}" for k, v in results["timings"].items()),
         "",
     ]
+    if results["online"]:
+        scene = results["config"]["online_scene"]
+        rows = [[name, run["views"], f"{run['planning_s']:.2f}", f"{run['gt']['chamfer_cm']:.3f}",
+                 f"{run['gt']['hausdorff_cm']:.3f}", f"{run['gt']['coverage']:.3f}"]
+                for name, run in results["online"].items()]
+        header = ["planner", "views", "planning (s)", "Chamfer vs gt (cm)", "Hausdorff vs gt (cm)",
+                  "coverage vs gt"]
+        lines += [f"## Online half: {scene} (held out): the policy's one pass, random views at its count", "",
+                  markdown_table(header, rows),
+                  "Trajectory: online_policy/trajectory.png. Paper Fig. 7 (vs its full scan): "
+                  + ", ".join(f"{k} Hausdorff {v['hausdorff_cm']} cm, Chamfer {v['chamfer_cm']} cm"
+                              for k, v in FIG7_GENERALISATION.items()) + ".", ""]
     return "\n".join(lines)

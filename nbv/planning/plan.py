@@ -23,6 +23,7 @@ import numpy as np
 
 from common.io import atomic_folder, check_output_folder, write_json
 from common.provenance import config_record
+from common.threads import chosen_threads, limit_torch_threads, worker_threads
 from nbv.bov.config import BoVConfig
 from nbv.planning.planners import Planner, PolicyPlanner, make_planner
 from nbv.recon.config import MetricsConfig, ReconstructionConfig
@@ -64,6 +65,9 @@ class PlanSettings:
     """Greedy planner: candidate viewpoints rendered per step."""
     reference: Path | None = None
     """Reference mesh (full-scan reconstruction); default: reconstruct the hemisphere scan, cached."""
+    full_scan: bool = True
+    """Also score against the full scan's reconstruction (`reference`); off: against the ground truth only
+    (no hemisphere scan to render)."""
     metrics: MetricsConfig = MetricsConfig()
     """How the reconstruction is scored."""
     recon: ReconstructionConfig = ReconstructionConfig()
@@ -115,12 +119,22 @@ def planning_env_config(config: PlanConfig, planner: Planner) -> EnvConfig:
 
 
 def choose_views(config: PlanConfig, planner: Planner,
-                 env_config: EnvConfig) -> tuple[list[Viewpoint], float]:
-    """The planner's viewpoints and the planning wall time in seconds (renders included)."""
+                 env_config: EnvConfig) -> tuple[list[Viewpoint], float, float]:
+    """The planner's viewpoints, the planning wall time in seconds (renders included) and the part of it
+    spent rendering the views flown to (the mean render time of a view times their count: images a real
+    camera captures anyway; greedy's other candidate renders stay planning time).
+
+    Torch runs on the thread policy's count (`common.threads.worker_threads`, 1) while planning, unless
+    this process already chose its threads; the previous count is restored afterwards.
+    """
     env = NBVEnv(env_config, seed=config.seed)
-    start = time.perf_counter()
-    views = planner.plan(env, config.views)
-    return views, time.perf_counter() - start
+    threads = 0 if chosen_threads() is not None else worker_threads()
+    with limit_torch_threads(threads):
+        start = time.perf_counter()
+        views = planner.plan(env, config.views)
+        seconds = time.perf_counter() - start
+    rendered = env.render_seconds / max(env.views_rendered, 1) * len(views) if env.views_rendered else 0.0
+    return views, seconds, min(rendered, seconds)
 
 
 def reference_mesh(config: PlanConfig, scene: Scene | None = None) -> Path:
@@ -159,7 +173,7 @@ def plan_scan(config: PlanConfig) -> dict:
     out = Path(config.out)
     check_output_folder(out, config.overwrite)
     planner = make_planner(config.planner, config.seed, config.candidates)
-    views, plan_s = choose_views(config, planner, planning_env_config(config, planner))
+    views, plan_s, flown_render_s = choose_views(config, planner, planning_env_config(config, planner))
     scene = config.scene.load()
     settings = replace(config.render, seed=config.seed)
     meta = {"planner": config.planner, "up_axis": config.scene.up_axis}
@@ -169,15 +183,17 @@ def plan_scan(config: PlanConfig) -> dict:
         recon = reconstruct_dataset(read_dataset(dataset), config.recon)
         save_reconstruction(recon, folder)
         scene.target_mesh().export(folder / "gt.ply")
-        reference = reference_mesh(config, scene)
+        reference = reference_mesh(config, scene) if config.full_scan else None
         gt = GroundTruth(gt=str(out / "gt.ply"))  # the normalised target: z up whatever the scene file's axis
         evaluation = EvaluateConfig(mesh=out / "mesh.ply", reference=reference, ground_truth=gt, out=out,
                                     metrics=config.metrics, seed=config.seed, overwrite=True)
-        references = {"gt": load_geometry(folder / "gt.ply", "gt"),
-                      "reference": load_geometry(reference, "reference")}
+        references = {"gt": load_geometry(folder / "gt.ply", "gt")}
+        if reference is not None:
+            references["reference"] = load_geometry(reference, "reference")
         results = write_evaluation(evaluation, load_geometry(folder / "mesh.ply", "mesh"), references, folder)
         doc = {"planner": config.planner, "scene": config.scene.scene, "views": len(views),
-               "planning_s": plan_s, "viewpoints": [v.as_array().tolist() for v in views],
+               "planning_s": plan_s, "deciding_s": plan_s - flown_render_s,
+               "viewpoints": [v.as_array().tolist() for v in views],
                "config": config_record(config),
                **{name: result.as_dict() for name, result in results.items()}}
         write_json(folder / "plan.json", doc)

@@ -31,7 +31,7 @@ from torchrl.envs.utils import ExplorationType, set_exploration_type
 
 from common.provenance import config_from_record
 from nbv.rl.agent import make_actor
-from nbv.rl.checkpoint import CheckpointError, checkpoint_config, load_checkpoint
+from nbv.rl.checkpoint import CheckpointError, load_policy
 from nbv.rl.config import EnvConfig, NetworkConfig
 from nbv.rl.env import NBVEnv
 from render.scan import HemispherePlan, hemisphere_scan
@@ -122,10 +122,10 @@ class GreedyBoVPlanner(Planner):
             best, best_reward, best_descriptors = None, -math.inf, None
             for view in sample_viewpoints(env.config, self.candidates, rng):
                 _, descriptors = env.capture(view)
-                reward = copy.deepcopy(env.bov).reward(descriptors, view.azimuth)
+                reward = copy.deepcopy(env.bov).reward(descriptors, view.azimuth, view.elevation)
                 if reward > best_reward:
                     best, best_reward, best_descriptors = view, reward, descriptors
-            env.bov.update(best_descriptors, best.azimuth)
+            env.bov.update(best_descriptors, best.azimuth, best.elevation)
             chosen.append(best)
         return chosen
 
@@ -137,18 +137,15 @@ class PolicyPlanner(Planner):
 
     def __init__(self, checkpoint: str | Path, sample: bool = False, seed: int = 0) -> None:
         self.sample, self.seed = sample, seed
-        state = load_checkpoint(checkpoint)
+        config, weights = load_policy(checkpoint)
         try:
-            config = checkpoint_config(state, checkpoint)
             self.env_config = config_from_record(EnvConfig, config["env"])
             network = config_from_record(NetworkConfig, config["network"])
             self.actor = make_actor(self.env_config.history, self.env_config.obs_size, network)
         except (KeyError, TypeError, ValueError, AttributeError, RuntimeError) as err:
             raise CheckpointError(f"checkpoint {checkpoint}: its config does not fit this toolkit: "
                                   f"{type(err).__name__}: {err}") from err
-        prefix = "actor_network_params."
         try:
-            weights = {k[len(prefix):]: v for k, v in state["loss"].items() if k.startswith(prefix)}
             self.actor.load_state_dict(weights)
         except (AttributeError, TypeError, RuntimeError) as err:
             raise CheckpointError(f"checkpoint {checkpoint}: actor weights do not fit: {err}") from err
@@ -182,16 +179,23 @@ class PolicyPlanner(Planner):
 
 POLICY_KINDS = ("policy", "policy-sample")
 """Spec prefixes of a trained policy: acting on its mode, or on seeded draws."""
+SHIPPED_POLICY = Path(__file__).with_name("shipped") / "policy.pt"
+"""The policy of the default `nbv train` command, shipped with the toolkit (its config, metrics log and
+learning curves beside it): what `policy` and `policy-sample` without a checkpoint use."""
 
 
 def split_policy_spec(spec: str) -> tuple[str, str] | None:
-    """(kind, checkpoint) of a `policy:CHECKPOINT` or `policy-sample:CHECKPOINT` spec; None for a baseline."""
+    """(kind, checkpoint) of a `policy[:CHECKPOINT]` or `policy-sample[:CHECKPOINT]` spec (no checkpoint:
+    the shipped policy); None for a baseline."""
     kind, sep, checkpoint = spec.partition(":")
-    return (kind, checkpoint) if sep and kind in POLICY_KINDS else None
+    if kind not in POLICY_KINDS:
+        return None
+    return kind, checkpoint if sep else str(SHIPPED_POLICY)
 
 
 def make_planner(spec: str, seed: int = 0, candidates: int = 8) -> Planner:
-    """A planner by name: random, circle, greedy, hemisphere, policy:CHECKPOINT, policy-sample:CHECKPOINT."""
+    """A planner by name: random, circle, greedy, hemisphere, policy[:CHECKPOINT], policy-sample[:CHECKPOINT]
+    (a training checkpoint.pt or a policy.pt; without one, the shipped policy)."""
     if policy := split_policy_spec(spec):
         kind, checkpoint = policy
         return PolicyPlanner(checkpoint, sample=kind == "policy-sample", seed=seed)
@@ -211,5 +215,5 @@ def planner_label(spec: str) -> str:
     """A short, file-name-safe label of a planner spec: a policy is named after its run folder."""
     if policy := split_policy_spec(spec):
         kind, checkpoint = policy
-        return f"{kind}-{Path(checkpoint).resolve().parent.name}"
+        return f"{kind}-{Path(checkpoint).resolve().parent.name}"  # the shipped one: policy-shipped
     return spec

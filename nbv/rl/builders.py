@@ -50,16 +50,17 @@ def make_sac_agent(env: EnvConfig, network: NetworkConfig) -> tuple[Probabilisti
 
 def make_loss_module(actor: ProbabilisticActor, critic: ValueOperator,
                      config: OptimConfig) -> tuple[SACLoss, SoftUpdate]:
-    """SAC (v2, no state-value network) with twin critics and fixed alpha, and its target updater."""
+    """SAC (v2, no state-value network) with twin critics, fixed or learned alpha, and its target updater."""
     loss = SACLoss(actor, critic, num_qvalue_nets=2, loss_function="l2", alpha_init=config.alpha,
-                   fixed_alpha=True, action_spec=actor.spec["action"])
+                   fixed_alpha=not config.auto_alpha, target_entropy="auto", action_spec=actor.spec["action"])
     loss.make_value_estimator(gamma=config.gamma)
     return loss, SoftUpdate(loss, tau=config.target_tau)
 
 
 def make_optimizers(loss: SACLoss, config: OptimConfig) -> tuple[torch.optim.Adam, torch.optim.Adam]:
-    """Adam for the actor and for the twin critics (alpha is fixed: no temperature optimiser)."""
-    actor = torch.optim.Adam(_trainable(loss.actor_network_params), lr=config.lr)
+    """Adam for the actor (and a learned temperature's log alpha) and for the twin critics."""
+    alpha = [loss.log_alpha] if config.auto_alpha else []
+    actor = torch.optim.Adam(_trainable(loss.actor_network_params) + alpha, lr=config.lr)
     critic = torch.optim.Adam(_trainable(loss.qvalue_network_params), lr=config.lr)
     return actor, critic
 

@@ -1,6 +1,8 @@
-"""Training checkpoints: written atomically, read with `torch.load(weights_only=True)`, validated.
+"""Training checkpoints and policy files: written atomically, read with `torch.load(weights_only=True)`.
 
-A checkpoint is a plain dict of tensors, numbers, strings and containers of
+A policy file (`policy.pt`, a few MB, written beside every checkpoint) holds
+what planning needs: the run's config as JSON, the actor's state dict and the
+counters. A checkpoint is a plain dict of tensors, numbers, strings and containers of
 them (nothing that needs pickle's arbitrary code): the run's config as JSON,
 the state dicts of the loss module (actor, twin critics, targets), optimisers
 and replay buffer, the counters, the random states of torch, NumPy and Python,
@@ -26,6 +28,10 @@ from common.io import atomic_path
 FORMAT = "nbv-sac-checkpoint"
 VERSION = 1
 REQUIRED = ("format", "version", "config", "loss", "optim_actor", "optim_critic", "buffer", "counters", "rng")
+POLICY_FORMAT = "nbv-sac-policy"
+POLICY_REQUIRED = ("format", "version", "config", "actor", "counters")
+ACTOR_PREFIX = "actor_network_params."
+"""Where the actor's weights sit in a checkpoint's loss state dict."""
 
 
 class CheckpointError(ValueError):
@@ -58,16 +64,16 @@ def seed_everything(seed: int) -> None:
     random.seed(seed)
 
 
-def save_checkpoint(path: str | Path, state: dict[str, Any]) -> Path:
-    """Write `state` (tagged with format and version) atomically to `path`."""
+def save_checkpoint(path: str | Path, state: dict[str, Any], kind: str = FORMAT) -> Path:
+    """Write `state` (tagged with format `kind` and version) atomically to `path`."""
     path = Path(path)
     with atomic_path(path) as tmp:
-        torch.save({"format": FORMAT, "version": VERSION, **state}, tmp)
+        torch.save({"format": kind, "version": VERSION, **state}, tmp)
     return path
 
 
-def load_checkpoint(path: str | Path) -> dict[str, Any]:
-    """Read and validate a checkpoint written by `save_checkpoint` (weights_only: no code runs)."""
+def load_checkpoint(path: str | Path, kinds: tuple[str, ...] = (FORMAT,)) -> dict[str, Any]:
+    """Read and validate a `save_checkpoint` file of one of `kinds` (weights_only: no code runs)."""
     path = Path(path)
     if not path.is_file():
         raise CheckpointError(f"checkpoint {path} not found")
@@ -75,15 +81,37 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
         state = torch.load(path, map_location="cpu", weights_only=True)
     except (RuntimeError, EOFError, OSError, zipfile.BadZipFile, pickle.UnpicklingError, ValueError) as err:
         raise CheckpointError(f"checkpoint {path} is corrupt or not a checkpoint: {err}") from err
-    if not isinstance(state, dict) or state.get("format") != FORMAT:
-        raise CheckpointError(f"checkpoint {path} is not an nbv SAC checkpoint")
+    if not isinstance(state, dict) or state.get("format") not in kinds:
+        names = " or ".join({FORMAT: "an nbv SAC checkpoint", POLICY_FORMAT: "an nbv policy file"}[k]
+                            for k in kinds)
+        raise CheckpointError(f"checkpoint {path} is not {names}")
     if state.get("version") != VERSION:
         raise CheckpointError(f"checkpoint {path} has version {state.get('version')}, "
                               f"this toolkit reads {VERSION}")
-    missing = [key for key in REQUIRED if key not in state]
+    required = POLICY_REQUIRED if state["format"] == POLICY_FORMAT else REQUIRED
+    missing = [key for key in required if key not in state]
     if missing:
         raise CheckpointError(f"checkpoint {path} lacks {', '.join(missing)}")
     return state
+
+
+def save_policy(path: str | Path, config: str, loss_state: dict[str, Any], counters: dict[str, int]) -> Path:
+    """Write a policy file: the run config (JSON text), the actor weights out of the loss state, counters."""
+    actor = {k[len(ACTOR_PREFIX):]: v for k, v in loss_state.items() if k.startswith(ACTOR_PREFIX)}
+    return save_checkpoint(path, {"config": config, "actor": actor, "counters": counters}, POLICY_FORMAT)
+
+
+def load_policy(path: str | Path) -> tuple[dict[str, Any], dict[str, torch.Tensor]]:
+    """The run config and actor weights of a policy file or a training checkpoint."""
+    state = load_checkpoint(path, (POLICY_FORMAT, FORMAT))
+    config = checkpoint_config(state, path)
+    if state["format"] == POLICY_FORMAT:
+        weights = state["actor"]
+    else:
+        loss = state["loss"]
+        weights = {k[len(ACTOR_PREFIX):]: v for k, v in loss.items() if k.startswith(ACTOR_PREFIX)} \
+            if isinstance(loss, dict) else loss
+    return config, weights
 
 
 def checkpoint_config(state: dict[str, Any], path: str | Path = "checkpoint") -> dict[str, Any]:

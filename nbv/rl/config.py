@@ -18,6 +18,7 @@ from typing import Annotated, Literal
 import numpy as np
 from tyro.conf import arg
 
+from common.threads import WORKER_THREADS
 from nbv.bov.config import BoVConfig
 from render.camera import UAVCamera
 from render.scan import check_camera_distance
@@ -147,9 +148,12 @@ class CollectorConfig:
     """Steps taken with uniformly random actions before the policy acts and learning starts."""
     seed: int = 0
     """Seed of torch, numpy, Python, the envs and the Bag of Views."""
-    threads: int = 0
-    """Torch CPU threads of the learner; 0: torch's default (one per core). The learner and an in-process
-    env take turns, so all cores help: 2 threads halved a batch-8 update on 2 idle cores (95 -> 46 ms)."""
+    threads: int = WORKER_THREADS
+    """Torch CPU threads of the learner (and of an in-process env); 0: torch's default (one per core).
+    Default: the thread policy's 1 (common/threads.py). On 2 idle cores 2 threads halved a batch-8 update
+    (95 -> 46 ms), but beside the renderer, workers or another job Kornia SIFT ran 50-80x slower on 2
+    threads than on 1 (160x120: 1.6 s vs 25 ms per view); give 2 only on cores nothing else uses.
+    ParallelEnv workers run 1 thread whatever this says (TorchRL's default, and the policy's)."""
 
     def __post_init__(self) -> None:
         if min(self.frames, self.envs) < 1 or self.threads < 0:
@@ -185,7 +189,10 @@ class OptimConfig:
     gamma: float = 0.99
     """Discount factor."""
     alpha: float = 0.2
-    """Entropy temperature, fixed."""
+    """Entropy temperature: fixed (Table 1), or the starting value with --auto-alpha."""
+    auto_alpha: bool = False
+    """Learn the temperature (SAC's automatic tuning towards an entropy of -3, one per action dimension)
+    instead of keeping it fixed."""
     target_update_interval: int = 20
     """Gradient steps between soft updates of the target critics."""
     target_tau: float = 0.01

@@ -19,7 +19,9 @@ every view at R = 1.5 m, 5 degrees up; on the held-out chalet those close,
 low views happened to cover the surface best, see paper_results/planners).
 
 Reward: the Bag of Views reward of the new view (vocabulary change - 1,
-docs/bov.md), from the config's `bov` (its match cosine included). The BoV is
+docs/bov.md), from the config's `bov` (its match cosine included; with
+`elevation_bands` E > 1 each azimuth range is split into E bands over the
+allowed elevations, beyond the paper). The BoV is
 emptied at each reset and learns the episode's first view without reward.
 
 Termination: one pass around the target, i.e. the net azimuth travelled
@@ -30,12 +32,16 @@ Rendering: one renderer per scene (loaded with the scene set's up axis),
 created lazily on the first reset, in the process that steps the env, so
 `ParallelEnv`'s spawned workers each choose their own Mitsuba variant; view k
 is rendered with the config's render settings' `view_seed(k)` under the env's
-seed. The constructor takes only picklable settings.
+seed. The constructor takes only picklable settings. Before the first view is
+rendered the process's torch threads follow the thread policy
+(`common.threads.apply_thread_policy`: 1 unless the process chose otherwise),
+since the renderer and Kornia SIFT share the cores with everything else.
 """
 
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import replace
 from typing import Any
 
@@ -46,6 +52,7 @@ from tensordict import TensorDict, TensorDictBase
 from torchrl.data import Bounded, Categorical, Composite, Unbounded
 from torchrl.envs import EnvBase
 
+from common.threads import apply_thread_policy
 from nbv.bov.bag import BagOfViews
 from nbv.features.sift import extract_features
 from nbv.rl.config import EnvConfig
@@ -151,6 +158,7 @@ class NBVEnv(EnvBase):
         self._rng = np.random.default_rng(self._seed)
         self._episode = 0
         self._views_rendered = 0
+        self.render_seconds = 0.0  # wall time of those renders (planning time without renders)
         self._bov = None
 
     def _reset(self, tensordict: TensorDictBase | None = None, **kwargs) -> TensorDictBase:
@@ -165,7 +173,7 @@ class NBVEnv(EnvBase):
         self._view = self.snap(Viewpoint(float(radius), float(azimuth), float(elevation)))
         self.bov.reset()
         frame, descriptors = self.capture(self._view)
-        self.bov.update(descriptors, self._view.azimuth)
+        self.bov.update(descriptors, self._view.azimuth, self._view.elevation)
         location = normalise_viewpoint(self._view, self.config)
         self._frames = np.repeat(frame[None], self.config.history, axis=0)
         self._locations = np.repeat(location[None], self.config.history, axis=0)
@@ -176,7 +184,7 @@ class NBVEnv(EnvBase):
     def _step(self, tensordict: TensorDictBase) -> TensorDictBase:
         view = self.snap(action_to_viewpoint(tensordict["action"], self._view, self.config))
         frame, descriptors = self.capture(view)
-        reward = self.bov.reward(descriptors, view.azimuth)
+        reward = self.bov.reward(descriptors, view.azimuth, view.elevation)
         self._progress += wrap_angle(view.azimuth - self._view.azimuth)
         self._view = view
         self._steps += 1
@@ -194,8 +202,14 @@ class NBVEnv(EnvBase):
     def bov(self) -> BagOfViews:
         """The episode's Bag of Views (created on first use)."""
         if self._bov is None:
-            self._bov = self.config.bov.bag(seed=self._seed)
+            bounds = (float(self.config.low[2]), float(self.config.high[2]))
+            self._bov = self.config.bov.bag(seed=self._seed, elevation_bounds=bounds)
         return self._bov
+
+    @property
+    def views_rendered(self) -> int:
+        """Views rendered since the seed was set (`render_seconds` is their wall time)."""
+        return self._views_rendered
 
     @property
     def viewpoint(self) -> Viewpoint | None:
@@ -233,7 +247,10 @@ class NBVEnv(EnvBase):
         renderer = self._renderer(self._scene)
         seed = self._render.view_seed(self._views_rendered)
         self._views_rendered += 1
-        return renderer.render_rgb(viewpoint_to_c2w(view, renderer.center), seed=seed)
+        start = time.perf_counter()
+        rgb = renderer.render_rgb(viewpoint_to_c2w(view, renderer.center), seed=seed)
+        self.render_seconds += time.perf_counter() - start
+        return rgb
 
     def snap(self, view: Viewpoint) -> Viewpoint:
         """`view` itself, or with a lattice (training) the nearest lattice node of the current scene."""
@@ -244,6 +261,7 @@ class NBVEnv(EnvBase):
 
         Rendered, or with a lattice read from the cache at the nearest node (`snap` first to see it).
         """
+        apply_thread_policy()  # here, not in __init__: in the process that steps the env
         if self.config.lattice.enabled:
             lattice = self._lattice(self._scene)
             return lattice.observe(lattice.snap(view)[1])

@@ -32,6 +32,7 @@ from tqdm import tqdm
 
 from common.io import write_json
 from common.provenance import config_record
+from common.threads import set_torch_threads
 from nbv.rl.builders import (
     make_collector,
     make_environment,
@@ -46,6 +47,7 @@ from nbv.rl.checkpoint import (
     load_checkpoint,
     rng_state,
     save_checkpoint,
+    save_policy,
     seed_everything,
     set_rng_state,
 )
@@ -54,15 +56,21 @@ from nbv.rl.env import NBVEnv
 from nbv.viz.figures import plot_training_curves
 
 CHECKPOINT = "checkpoint.pt"
-RESUMABLE_CHANGES = ("collector.frames", "logger.out", "logger.checkpoint_every", "logger.progress")
+POLICY = "policy.pt"
+"""The actor and config alone (a few MB, for planning), written beside every checkpoint."""
+RESUMABLE_CHANGES = ("collector.frames", "collector.threads", "logger.out", "logger.checkpoint_every",
+                     "logger.progress")
 """Settings a resumed run may change, as dotted paths into the nested config record (a difference
-anywhere else, e.g. `env.bov.match_cosine` or `env.camera.width`, is refused)."""
+anywhere else, e.g. `env.bov.match_cosine` or `env.camera.width`, is refused). Threads change speed, and
+at most float rounding: runs recorded before the thread policy (threads 0) resume under its default 1."""
 CSV_FIELDS = ("frames", "updates", "reward_mean", "episode_return", "episodes", "loss_actor", "loss_qvalue",
-              "entropy", "collect_s", "update_s")
+              "entropy", "alpha", "collect_s", "update_s")
 
 
 def train(config: TrainConfig) -> Path:
-    """Train (or resume training) into `config.logger.out`; return the checkpoint path."""
+    """Train (or resume training) into `config.logger.out`; return the checkpoint path.
+
+    `policy.pt` beside it holds the actor alone (what `nbv plan --planner policy:RUN/policy.pt` needs)."""
     run = Path(config.logger.out)
     run.mkdir(parents=True, exist_ok=True)
     ckpt_path = run / CHECKPOINT
@@ -73,8 +81,7 @@ def train(config: TrainConfig) -> Path:
     write_json(run / "config.json", config_record(config))
     seed = config.collector.seed
     seed_everything(seed)
-    if config.collector.threads:
-        torch.set_num_threads(config.collector.threads)
+    set_torch_threads(config.collector.threads)  # recorded: an in-process env keeps this choice
 
     # Networks, loss, optimisers, replay buffer.
     actor, critic = make_sac_agent(config.env, config.network)
@@ -160,27 +167,31 @@ def train(config: TrainConfig) -> Path:
 
 def sac_update(loss_module: SACLoss, optim_actor: torch.optim.Optimizer, optim_critic: torch.optim.Optimizer,
                sample: TensorDictBase, reward_scale: float = 1.0) -> dict[str, float]:
-    """One SAC gradient step on a replay sample, rewards scaled (alpha fixed: its loss is not optimised)."""
+    """One SAC gradient step on a replay sample, rewards scaled; a learned alpha steps with the actor."""
     if reward_scale != 1.0:
         sample.set(("next", "reward"), sample["next", "reward"] * reward_scale)
     losses = loss_module(sample)
     optim_critic.zero_grad()
     optim_actor.zero_grad()
-    (losses["loss_actor"] + losses["loss_qvalue"]).backward()
+    total = losses["loss_actor"] + losses["loss_qvalue"]
+    if loss_module.log_alpha.requires_grad:
+        total = total + losses["loss_alpha"]
+    total.backward()
     optim_critic.step()
     optim_actor.step()
     return {"loss_actor": losses["loss_actor"].item(), "loss_qvalue": losses["loss_qvalue"].item(),
-            "entropy": losses["entropy"].item()}
+            "entropy": losses["entropy"].item(), "alpha": losses["alpha"].item()}
 
 
 def write_checkpoint(path: Path, config: TrainConfig, loss_module: SACLoss,
                      optim_actor: torch.optim.Optimizer, optim_critic: torch.optim.Optimizer,
                      buffer: ReplayBuffer, frames: int, updates: int, env: NBVEnv | None) -> Path:
-    """Save everything a resumed run needs (see the module docstring)."""
+    """Save everything a resumed run needs (see the module docstring), and the policy file beside it."""
     state = {"config": json.dumps(config_record(config)), "loss": loss_module.state_dict(),
              "optim_actor": optim_actor.state_dict(), "optim_critic": optim_critic.state_dict(),
              "buffer": buffer.state_dict(), "counters": {"frames": frames, "updates": updates},
              "rng": rng_state()}
     if env is not None:
         state["env"] = env.snapshot()
+    save_policy(path.parent / POLICY, state["config"], state["loss"], state["counters"])
     return save_checkpoint(path, state)

@@ -117,6 +117,26 @@ def plot_planner_comparison(runs: Sequence[dict], paper: dict, out: str | Path, 
     return _save(fig, out)
 
 
+def plot_seed_scores(scores: dict[str, Sequence[float]], out: str | Path, ylabel: str, title: str = "",
+                     references: dict[str, float] | None = None) -> Path:
+    """Save a chart of one score per candidate: the mean as a bar, each seed as a dot, references dashed."""
+    names = list(scores)
+    fig = Figure(figsize=(1.2 * len(names) + 3.0, 4.2))
+    ax = fig.subplots()
+    ax.bar(range(len(names)), [np.mean(scores[n]) for n in names], color="tab:blue", alpha=0.6)
+    for i, name in enumerate(names):
+        ax.plot([i] * len(scores[name]), scores[name], "o", color="black", markersize=4)
+    for (label, value), colour in zip((references or {}).items(), ("tab:red", "tab:green", "tab:orange")):
+        ax.axhline(value, color=colour, linestyle="--", label=label)
+    ax.set_xticks(range(len(names)), names, rotation=30, ha="right", fontsize=8)
+    ax.set_ylabel(ylabel)
+    if references:
+        ax.legend(fontsize=8)
+    if title:
+        ax.set_title(title)
+    return _save(fig, out)
+
+
 def training_curves(csv_path: str | Path, window: int = 500) -> dict[str, np.ndarray]:
     """Trailing-window means of a `nbv train` metrics.csv: reward per step, return, steps per episode.
 

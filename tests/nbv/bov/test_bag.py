@@ -192,3 +192,28 @@ def test_view_score_masks_padding():
     mask = torch.tensor([[True, True], [True, False]])
     words = E[:1].expand(2, 1, 4)
     torch.testing.assert_close(view_score(x, words, mask, match_cosine=0.5), torch.tensor([-1.0 + 1.0, -1.0]))
+
+
+def test_elevation_bands_split_each_azimuth_range():
+    bov = BagOfViews(ranges=2, words=1, dim=4, bands=2, elevation_bounds=(0.0, 1.0))
+    assert bov.ranges == 4 and tuple(bov.words.shape) == (4, 1, 4)
+    # id = azimuth range * E + band; elevations outside the bounds clamp to the end bands
+    assert [bov.range_of(0.1, e) for e in (-1.0, 0.2, 0.6, 5.0)] == [0, 0, 1, 1]
+    assert [bov.range_of(4.0, e) for e in (0.2, 0.6)] == [2, 3]
+    bov.update(E[:1], 0.1, 0.2)  # a low view of range 0
+    assert bov.score(E[:1], 0.1, 0.2) < 0  # seen again low: not new
+    assert bov.score(E[:1], 0.1, 0.8) == math.inf  # the same appearance from high up: a new range
+    flat = BagOfViews(ranges=2, words=1, dim=4)
+    flat.update(E[:1], 0.1, 0.2)
+    assert flat.score(E[:1], 0.1, 0.8) < 0  # the paper's azimuth-only ranges cannot tell them apart
+    with pytest.raises(ValueError, match="elevation_bounds"):
+        BagOfViews(ranges=2, words=1, bands=2)
+
+
+def test_bov_config_elevation_bands():
+    from nbv.bov.config import BoVConfig
+
+    bag = BoVConfig(ranges=8, words=5, elevation_bands=2).bag(elevation_bounds=(0.1, 1.3))
+    assert bag.ranges == 16 and bag.bands == 2
+    with pytest.raises(ValueError, match="elevation_bands"):
+        BoVConfig(elevation_bands=0)

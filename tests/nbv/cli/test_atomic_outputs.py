@@ -293,7 +293,8 @@ def test_compare_interrupted_keeps_the_previous_comparison_and_the_runs(tmp_path
     for seed in (0, 1):
         (out / f"random-seed{seed}").mkdir(parents=True)
         (out / f"random-seed{seed}" / "plan.json").write_text(
-            json.dumps({"views": 13, "gt": metrics, "reference": metrics}))
+            json.dumps({"views": 13, "gt": metrics, "reference": metrics, "planning_s": 0.0,
+                        "deciding_s": 0.0}))
     monkeypatch.setattr("nbv.experiments.compare.plot_planner_comparison",
                         lambda runs, paper, path, title: Path(path).write_bytes(b"png"))
     config = CompareConfig(scene=SceneSpec(scene="alpine_chalet"), planners=("random",), seeds=(0,), out=out)

@@ -33,7 +33,8 @@ def test_compare_planners_reads_back_finished_runs(tmp_path):
     for seed in (0, 1):
         (tmp_path / f"circle-seed{seed}").mkdir()
         (tmp_path / f"circle-seed{seed}" / "plan.json").write_text(
-            json.dumps({"views": 13, "gt": metrics, "reference": metrics}))
+            json.dumps({"views": 13, "gt": metrics, "reference": metrics, "planning_s": 0.0,
+                        "deciding_s": 0.0}))
     done = run_nbv("compare", "alpine_chalet", "--planners", "circle", "--seeds", "0", "1",
                    "--out", str(tmp_path))
     assert done.returncode == 0, done.stderr

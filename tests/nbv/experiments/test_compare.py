@@ -19,7 +19,8 @@ def test_compare_planners_tabulates_saved_runs(tmp_path):
         folder = tmp_path / f"random-seed{seed}"
         folder.mkdir()
         (folder / "plan.json").write_text(json.dumps({"views": 13, "gt": metrics(coverage, 0.5, 8.0),
-                                                      "reference": metrics(coverage + 0.1, 0.4, 6.0)}))
+                                                      "reference": metrics(coverage + 0.1, 0.4, 6.0),
+                                                      "planning_s": 1.0, "deciding_s": 0.5}))
     config = CompareConfig(scene=SceneSpec(scene="alpine_chalet"), planners=("random",), seeds=(0, 1),
                            out=tmp_path)
     table = compare_planners(config)

@@ -2,16 +2,42 @@
 
 import json
 
+from nbv.bov.config import BoVConfig
 from nbv.cli import main
+from nbv.rl.builders import make_loss_module, make_optimizers, make_replay_buffer, make_sac_agent
+from nbv.rl.config import EnvConfig, LoggerConfig, OptimConfig, TrainConfig
+from nbv.rl.train import write_checkpoint
+from render.camera import UAVCamera
+from render.settings import RenderSettings
+from scenes.spec import SceneSet
+
+
+def untrained_policy(run) -> str:
+    """A `policy.pt` of untrained networks on a tiny env (the demo's online half only needs its shape)."""
+    env = EnvConfig(scenes=SceneSet(scene=("test_building",)), camera=UAVCamera(64, 48),
+                    render=RenderSettings(spp=1), bov=BoVConfig(ranges=8, features="opencv"), obs_size=32,
+                    max_steps=3)
+    config = TrainConfig(env=env, logger=LoggerConfig(out=run))
+    actor, critic = make_sac_agent(env, config.network)
+    loss, _ = make_loss_module(actor, critic, OptimConfig())
+    optim_actor, optim_critic = make_optimizers(loss, OptimConfig())
+    run.mkdir()
+    write_checkpoint(run / "checkpoint.pt", config, loss, optim_actor, optim_critic,
+                     make_replay_buffer(config.replay_buffer), 0, 0, None)
+    return f"policy:{run / 'policy.pt'}"
 
 
 def test_demo_runs_every_stage_and_reuses_its_scan(tmp_path, capsys):
-    args = ["demo", "--out", str(tmp_path), "--scene", "test_building", "--width", "96", "--height", "72",
+    out = tmp_path / "demo"
+    args = ["demo", "--out", str(out), "--scene", "test_building", "--width", "96", "--height", "72",
             "--spp", "2", "--end-overlap", "0.5", "--side-overlap", "0.4", "--ranges", "3", "--words", "5",
-            "--voxel-size-m", "0.01", "--metric-points", "5000"]
+            "--voxel-size-m", "0.01", "--metric-points", "5000", "--online-scene", "test_building",
+            "--policy", untrained_policy(tmp_path / "run")]
+    tmp_path = out
     assert main(args) == 0
     printed = capsys.readouterr().out
     assert "| refined |" in printed and "Paper (Table 2" in printed
+    assert "## Online half: test_building (held out)" in printed and "| random | " in printed
     results = json.loads((tmp_path / "results.json").read_text())
     assert 0 < results["views_refined"] <= results["views_full"]
     for ref in ("gt", "reference"):
@@ -24,5 +50,10 @@ def test_demo_runs_every_stage_and_reuses_its_scan(tmp_path, capsys):
     for sub in ("recon_full/mesh.ply", "recon_refined/points.ply", "refined/refine.json"):
         assert (tmp_path / sub).is_file()
     stamp = (tmp_path / "full_scan" / "transforms.json").stat().st_mtime_ns
-    assert main(args) == 0
+    online = results["online"]
+    assert 2 <= online["policy"]["views"] <= 4 and online["random"]["views"] == online["policy"]["views"]
+    assert 0 < online["policy"]["gt"]["coverage"] <= 1
+    assert (tmp_path / "online_policy" / "trajectory.png").is_file()
+    assert main([*args, "--no-online"]) == 0
     assert (tmp_path / "full_scan" / "transforms.json").stat().st_mtime_ns == stamp  # not re-rendered
+    assert json.loads((tmp_path / "results.json").read_text())["online"] == {}

@@ -65,3 +65,27 @@ def test_the_plans_bov_and_camera_reach_the_greedy_planners_env(tmp_path):
     assert env.bov.match_cosine == 0.6 and env.bov.ranges == 4
     assert env.config.camera.focal_mm == 20.0
     assert env.config.scenes == SceneSet(scene=("house.obj",), up_axis="y")
+
+
+def test_choose_views_plans_on_the_thread_policy_and_restores_torch(tmp_path, monkeypatch):
+    import torch
+
+    from common import threads
+    from nbv.planning.plan import choose_views, scan_env_config
+
+    class Recorder:
+        def plan(self, env, views):
+            seen.append(torch.get_num_threads())
+            return []
+
+    config = PlanConfig(scene=SceneSpec(scene="house.obj", up_axis="y"), out=tmp_path)
+    before, seen = torch.get_num_threads(), []
+    monkeypatch.setattr(threads, "_chosen", None)
+    try:
+        torch.set_num_threads(2)
+        choose_views(config, Recorder(), scan_env_config(config))
+        threads.set_torch_threads(2)  # a process that chose keeps its choice
+        choose_views(config, Recorder(), scan_env_config(config))
+        assert seen == [threads.worker_threads(), 2] and torch.get_num_threads() == 2
+    finally:
+        torch.set_num_threads(before)

@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 
 import pytest
 import torch
 
 from nbv.bov.config import BoVConfig
 from nbv.planning.planners import (
+    SHIPPED_POLICY,
     CirclePlanner,
     GreedyBoVPlanner,
     HemispherePlanner,
@@ -17,10 +19,11 @@ from nbv.planning.planners import (
     RandomPlanner,
     make_planner,
     planner_label,
+    split_policy_spec,
 )
 from nbv.rl.builders import make_loss_module, make_optimizers, make_replay_buffer, make_sac_agent
 from nbv.rl.checkpoint import CheckpointError, save_checkpoint
-from nbv.rl.config import EnvConfig, LoggerConfig, OptimConfig, TrainConfig
+from nbv.rl.config import EnvConfig, LatticeConfig, LoggerConfig, OptimConfig, TrainConfig
 from nbv.rl.env import NBVEnv
 from nbv.rl.train import write_checkpoint
 from render.camera import UAVCamera
@@ -73,7 +76,7 @@ def test_greedy_picks_the_candidate_of_highest_reward(monkeypatch):
 
     monkeypatch.setattr(env, "reset", lambda: None)
     monkeypatch.setattr(env, "capture", fake_capture)
-    monkeypatch.setattr(type(env.bov), "reward", lambda self, d, az: next(rewards))
+    monkeypatch.setattr(type(env.bov), "reward", lambda self, d, az, el: next(rewards))
     views = planner.plan(env, 2)
     assert views[1] == chosen_candidates[1]
 
@@ -133,3 +136,36 @@ def test_bad_planner_specs(tmp_path):
                                           "optim_critic": {}, "buffer": {}, "counters": {}, "rng": {}})
     with pytest.raises(CheckpointError, match="config does not fit.*no field.*bov_ranges"):
         make_planner(f"policy:{tmp_path / 'old.pt'}")
+
+
+def test_policy_file_plans_like_its_checkpoint(tmp_path):
+    env = tiny_env(max_steps=3)
+    save_untrained_policy(tmp_path / "checkpoint.pt", env)
+    policy = tmp_path / "policy.pt"  # written beside every checkpoint: the actor and config alone
+    assert policy.stat().st_size < (tmp_path / "checkpoint.pt").stat().st_size
+    from_file = make_planner(f"policy:{policy}").plan(tiny_env(max_steps=3), 4)
+    assert from_file == make_planner(f"policy:{tmp_path / 'checkpoint.pt'}").plan(tiny_env(max_steps=3), 4)
+
+
+def test_bare_policy_spec_is_the_shipped_policy():
+    assert split_policy_spec("policy") == ("policy", str(SHIPPED_POLICY))
+    assert split_policy_spec("policy-sample") == ("policy-sample", str(SHIPPED_POLICY))
+    assert split_policy_spec("policy:run/policy.pt") == ("policy", "run/policy.pt")
+    assert planner_label("policy") == "policy-shipped" and split_policy_spec("random") is None
+
+
+def test_shipped_policy_is_the_default_training_command_and_plans():
+    from common.provenance import config_record
+    from nbv.cli.train import parse_train
+
+    raw = torch.load(SHIPPED_POLICY, weights_only=True)  # no pickled code in the shipped file
+    assert raw["format"] == "nbv-sac-policy" and SHIPPED_POLICY.stat().st_size < 5_000_000
+    shipped = json.loads(raw["config"])
+    default = config_record(parse_train(["--out", "runs/default"]))
+    for group in ("env", "collector", "replay_buffer", "optim", "network"):
+        assert shipped[group] == default[group], group  # `nbv train --out runs/default` retrains it
+    planner = make_planner("policy")
+    assert isinstance(planner, PolicyPlanner) and planner.env_config.bov.elevation_bands == 2
+    env = NBVEnv(replace(planner.env_config, scenes=TEST_BUILDING, lattice=LatticeConfig()))
+    views = planner.plan(env, 3)
+    assert len(views) == 3 and all(in_ranges(v, env.config) for v in views)

@@ -12,8 +12,10 @@ from nbv.rl.checkpoint import (
     CheckpointError,
     check_compatible,
     load_checkpoint,
+    load_policy,
     rng_state,
     save_checkpoint,
+    save_policy,
     set_rng_state,
 )
 
@@ -66,3 +68,20 @@ def test_mismatched_settings_are_listed():
     current = {"env": {"obs_size": 32, "scene": ["a"]}, "collector": {"frames": 100}}
     with pytest.raises(CheckpointError, match=r"env.obs_size: checkpoint 64, now 32"):
         check_compatible("c.pt", saved, current, free=("collector.frames",))
+
+
+def test_policy_file_holds_the_actor_alone(tmp_path):
+    loss = {"actor_network_params.module.0.weight": torch.ones(2), "qvalue_network_params.w": torch.zeros(3)}
+    state = {**minimal_state(), "config": '{"env": {}}', "loss": loss}
+    save_checkpoint(tmp_path / "checkpoint.pt", state)
+    save_policy(tmp_path / "policy.pt", state["config"], loss, state["counters"])
+    raw = torch.load(tmp_path / "policy.pt", weights_only=True)  # an independent reader: plain torch
+    assert raw["format"] == "nbv-sac-policy" and set(raw["actor"]) == {"module.0.weight"}
+    for path in ("policy.pt", "checkpoint.pt"):  # either file gives the same config and actor
+        config, weights = load_policy(tmp_path / path)
+        assert config == {"env": {}} and set(weights) == {"module.0.weight"}
+    with pytest.raises(CheckpointError, match="not an nbv SAC checkpoint"):
+        load_checkpoint(tmp_path / "policy.pt")  # resuming training needs the whole checkpoint
+    torch.save({"weights": torch.zeros(1)}, tmp_path / "other.pt")
+    with pytest.raises(CheckpointError, match="not an nbv policy file or an nbv SAC checkpoint"):
+        load_policy(tmp_path / "other.pt")

@@ -181,3 +181,31 @@ def test_snapshot_restore_continues_the_episode():
     assert torch.equal(out_a["pixels"], out_b["pixels"])
     assert float(out_a["reward"]) == float(out_b["reward"])
     np.testing.assert_array_equal(a.snapshot()["frames"], b.snapshot()["frames"])
+
+
+def test_env_puts_torch_on_the_thread_policy_when_it_first_renders(monkeypatch):
+    from common import threads
+
+    before = torch.get_num_threads()
+    monkeypatch.setattr(threads, "_chosen", None)
+    try:
+        torch.set_num_threads(2)
+        env = NBVEnv(tiny_config(), seed=0)
+        assert torch.get_num_threads() == 2  # the constructor runs in the parent: it sets nothing
+        env.reset()
+        assert torch.get_num_threads() == threads.worker_threads() == 1
+    finally:
+        torch.set_num_threads(before)
+
+
+def test_env_keeps_threads_the_process_chose(monkeypatch):
+    from common import threads
+
+    before = torch.get_num_threads()
+    monkeypatch.setattr(threads, "_chosen", None)
+    try:
+        threads.set_torch_threads(2)  # e.g. `nbv train --threads 2` with an in-process env
+        NBVEnv(tiny_config(), seed=0).reset()
+        assert torch.get_num_threads() == 2
+    finally:
+        torch.set_num_threads(before)

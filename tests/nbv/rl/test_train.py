@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import math
 from dataclasses import replace
 
 import pytest
@@ -14,7 +15,7 @@ from nbv.bov.config import BoVConfig
 from nbv.cli import main
 from nbv.rl.builders import make_loss_module, make_optimizers, make_sac_agent
 from nbv.rl.checkpoint import CheckpointError, load_checkpoint
-from nbv.rl.config import CollectorConfig, EnvConfig, LoggerConfig, TrainConfig
+from nbv.rl.config import CollectorConfig, EnvConfig, LoggerConfig, OptimConfig, TrainConfig
 from nbv.rl.train import sac_update, train
 from render.camera import UAVCamera
 from render.settings import RenderSettings
@@ -87,6 +88,28 @@ def test_reward_scale_is_the_same_update_as_scaled_rewards():
     scaled = one_update(1.0, 0.1)
     assert all(torch.equal(a, b) for a, b in zip(scaled, one_update(0.1, 1.0)))
     assert not all(torch.equal(a, b) for a, b in zip(scaled, one_update(1.0, 1.0)))
+
+
+def test_auto_alpha_learns_the_temperature_and_fixed_alpha_keeps_it():
+    def alphas(auto: bool) -> list[float]:
+        torch.manual_seed(0)
+        config = replace(tiny(None, 10), optim=OptimConfig(auto_alpha=auto))
+        actor, critic = make_sac_agent(config.env, config.network)
+        loss, _ = make_loss_module(actor, critic, config.optim)
+        optim_actor, optim_critic = make_optimizers(loss, config.optim)
+        n, side = 4, config.env.obs_size
+        state = {"pixels": torch.full((n, 5, side, side), 100, dtype=torch.uint8),
+                 "viewpoints": torch.zeros(n, 5, 3)}
+        sample = TensorDict({**state, "action": torch.zeros(n, 3), "next": TensorDict({
+            **state, "reward": torch.ones(n, 1), "done": torch.zeros(n, 1, dtype=torch.bool),
+            "terminated": torch.zeros(n, 1, dtype=torch.bool)}, [n])}, [n])
+        return [sac_update(loss, optim_actor, optim_critic, sample.clone())["alpha"] for _ in range(3)]
+
+    assert alphas(False) == pytest.approx([0.2] * 3)
+    learned = alphas(True)
+    # The untrained policy's entropy (about 2) is above the target -3: log alpha falls by lr each step.
+    assert learned[0] == pytest.approx(0.2) and learned[2] < learned[1] < learned[0]
+    assert learned[1] == pytest.approx(0.2 * math.exp(-5e-4), rel=1e-4)
 
 
 def test_resuming_with_other_settings_is_refused(tmp_path):

@@ -1,0 +1,169 @@
+"""`nbv online`: the paper's online half on held-out buildings, the shipped policy against the baselines.
+
+Two protocols per building, each an `nbv compare` folder (runs already there are read back):
+- `views13/`: every planner captures 13 views (the paper's Fig. 1 count), one run per seed
+  (start view, renders, random draws);
+- `onepass/`: the policy stops after one pass around the target, its own view count, as in
+  the paper, scored against the full scan beside Fig. 1 and Fig. 7.
+
+`online.md` gives, per building and overall, the mean coverage of the true surface at 13 views
+and the policy's margins over random, circle and greedy Bag of Views with its planning speed-up
+over greedy (issue 11's acceptance figures), then the one-pass table. The buildings default to
+the held-out ones: nothing here trains or tunes anything.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from common.io import atomic_folder, markdown_table, write_json, write_text
+from common.provenance import config_record, git_commit
+from nbv.experiments.compare import CompareConfig, compare_planners
+from nbv.experiments.paper_numbers import FIG1_NBV, FIG7_GENERALISATION
+from nbv.planning.planners import planner_label
+from nbv.recon.config import MetricsConfig
+from nbv.viz.figures import plot_seed_scores
+from render.settings import RenderSettings
+from scenes.spec import SceneSpec
+
+HELD_OUT = ("alpine_chalet", "imperial_temple", "random:0", "random:5", "random:10")
+"""The evaluation buildings: both held-out presets and three test-split random buildings."""
+OUTPUTS = ("online.md", "online.json", "online.png")
+"""What `nbv online` writes into `--out` together, beside the per-building folders."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class OnlineConfig:
+    """Settings of `nbv online`."""
+
+    out: Path
+    """Folder of the per-building comparisons and of online.{md,json,png}."""
+    scenes: tuple[str, ...] = HELD_OUT
+    """Buildings to plan for (held out from training)."""
+    policies: tuple[str, ...] = ("policy",)
+    """Policies to evaluate on their mode (policy = the shipped one; policy:CHECKPOINT for others); the
+    first is the one the margins and the one-pass table describe."""
+    baselines: tuple[str, ...] = ("random", "circle", "greedy")
+    """Baseline planners at the same view count."""
+    seeds: tuple[int, ...] = (0, 1, 2, 3, 4)
+    """Evaluation seeds per planner and building."""
+    views: int = 13
+    """The fixed view budget."""
+    one_pass: bool = True
+    """Also run the paper's protocol: the first policy's own episode (one pass), against the full scan."""
+    render: RenderSettings = RenderSettings()
+    """How views are rendered (the Mitsuba variant included)."""
+    metrics: MetricsConfig = MetricsConfig(n_points=200_000)
+    """How reconstructions are scored (200k points per surface, as `nbv demo` and `nbv tables`)."""
+
+    def __post_init__(self) -> None:
+        if not (self.scenes and self.policies and self.seeds):
+            raise ValueError("nbv online needs at least one scene, one policy and one seed")
+        if self.views < 1:
+            raise ValueError(f"views must be >= 1, got {self.views}")
+
+
+def scene_folder(scene: str) -> str:
+    """A file-name-safe folder name of a scene (random:5 -> random_5)."""
+    return Path(scene.replace(":", "_")).name
+
+
+def run_online(config: OnlineConfig) -> str:
+    """Run (or read back) every comparison; write online.{md,json,png}; return the Markdown."""
+    out = Path(config.out)
+    budget, one_pass = {}, {}
+    for scene in config.scenes:
+        common = {"scene": SceneSpec(scene=scene), "render": config.render, "metrics": config.metrics,
+                  "seeds": config.seeds}
+        folder = out / scene_folder(scene)
+        compare_planners(CompareConfig(**common, views=config.views, out=folder / f"views{config.views}",
+                                       planners=(*config.policies, *config.baselines)))
+        budget[scene] = _runs(folder / f"views{config.views}")
+        if config.one_pass:
+            compare_planners(CompareConfig(**common, planners=config.policies[:1], out=folder / "onepass"))
+            one_pass[scene] = _runs(folder / "onepass")
+    policy = planner_label(config.policies[0])
+    text = online_report(budget, one_pass, policy, config)
+    coverage = {label: [np.mean(_values(runs[label], "gt", "coverage")) * 100 for runs in budget.values()]
+                for label in next(iter(budget.values()))}
+    with atomic_folder(out, overwrite=True, outputs=OUTPUTS) as folder:
+        write_text(folder / "online.md", text)
+        plot_seed_scores(coverage, folder / "online.png",
+                         f"coverage % of the true surface, {config.views} views",
+                         f"mean over {len(config.seeds)} seeds; one dot per building")
+        write_json(folder / "online.json", {"commit": git_commit(), "config": config_record(config),
+                                            "budget": budget, "one_pass": one_pass})
+    return text
+
+
+def _runs(folder: Path) -> dict[str, list[dict]]:
+    doc = json.loads((folder / "comparison.json").read_text())
+    by_planner: dict[str, list[dict]] = {}
+    for run in doc["runs"]:
+        by_planner.setdefault(run["planner"], []).append(run)
+    return by_planner
+
+
+def _values(runs: list[dict], against: str, key: str) -> list[float]:
+    return [r[against][key] for r in runs]
+
+
+def online_report(budget: dict[str, dict[str, list[dict]]], one_pass: dict[str, dict[str, list[dict]]],
+                  policy: str, config: OnlineConfig) -> str:
+    """The Markdown report: 13-view coverage per building with the policy's margins, then one pass."""
+    labels = list(next(iter(budget.values())))
+    rows, means = [], {label: [] for label in labels}
+    for scene, runs in budget.items():
+        row = [scene]
+        for label in labels:
+            value = 100 * float(np.mean(_values(runs[label], "gt", "coverage")))
+            means[label].append(value)
+            row.append(f"{value:.1f}")
+        rows.append(row)
+    overall = {label: float(np.mean(v)) for label, v in means.items()}
+    rows.append(["**mean**", *(f"**{overall[label]:.1f}**" for label in labels)])
+    planning = {label: float(np.mean([r["planning_s"] for runs in budget.values() for r in runs[label]]))
+                for label in labels}
+    deciding = {label: float(np.mean([r["deciding_s"] for runs in budget.values() for r in runs[label]]))
+                for label in labels}
+    lines = [f"# Online NBV on held-out buildings (commit {git_commit()})", "",
+             f"Coverage (%) of the true surface within {config.metrics.threshold_cm:g} cm, "
+             f"{config.views} views, mean over seeds {', '.join(map(str, config.seeds))}; "
+             "policies act on their mode.", "",
+             markdown_table(["building", *labels], rows), "",
+             "Planning time per scan, s (all / without rendering the views flown to, `plan.json`'s "
+             "`planning_s` / `deciding_s`): "
+             + ", ".join(f"{label} {planning[label]:.2f} / {deciding[label]:.2f}" for label in labels), ""]
+    for other in ("random", "circle", "greedy"):
+        if other in overall and policy in overall:
+            lines.append(f"- {policy} minus {other}: {overall[policy] - overall[other]:+.1f} points")
+    if "greedy" in deciding and policy in deciding:
+        lines.append("- planning speed-up over greedy (without rendering the views flown to): "
+                     f"{deciding['greedy'] / deciding[policy]:.0f}x")
+    if one_pass:
+        lines += ["", "## One pass around the target (the paper's protocol), against the full 288-view scan",
+                  "", _one_pass_table(one_pass, policy)]
+    return "\n".join(lines) + "\n"
+
+
+def _one_pass_table(one_pass: dict[str, dict[str, list[dict]]], policy: str) -> str:
+    rows = []
+    for scene, runs in one_pass.items():
+        mine = runs[policy]
+        rows.append([f"{scene} ({policy})", f"{np.mean([r['views'] for r in mine]):.1f}",
+                     f"{100 * np.mean(_values(mine, 'reference', 'coverage')):.1f}",
+                     f"{np.mean(_values(mine, 'reference', 'hausdorff_cm')):.2f}",
+                     f"{np.mean(_values(mine, 'reference', 'chamfer_cm')):.2f}",
+                     f"{100 * np.mean(_values(mine, 'gt', 'coverage')):.1f}"])
+    rows.append(["paper Fig. 1 (its training building)", FIG1_NBV["views"],
+                 f"{100 * FIG1_NBV['coverage']:.1f}", f"{FIG1_NBV['hausdorff_cm']:.2f}",
+                 f"{FIG1_NBV['chamfer_cm']:.2f}", "-"])
+    for scene, fig7 in FIG7_GENERALISATION.items():
+        rows.append([f"paper Fig. 7 ({scene})", "-", "-", f"{fig7['hausdorff_cm']:.2f}",
+                     f"{fig7['chamfer_cm']:.2f}", "-"])
+    return markdown_table(["episode", "views", "coverage % (ref)", "Hausdorff cm (ref)", "Chamfer cm (ref)",
+                           "coverage % (gt)"], rows)

@@ -1,0 +1,163 @@
+"""Choose `nbv train`'s defaults by validation performance (issue 11): candidates x training seeds.
+
+Each candidate is the shared base command plus its flags; every (candidate, seed) run trains on the
+training buildings (`TRAIN_SCENES`) and is scored on validation buildings that no run trains on
+(`VALIDATION_SCENES`: training-split `random:SEED` buildings; the test buildings alpine_chalet,
+imperial_temple and random:SEED with SEED % 5 == 0 are never touched here). The score is the policy's
+mode over `--episodes` start views per building, rendered at exact viewpoints, scored by the
+visible-surface coverage of the true mesh (`nbv.planning.visibility`).
+
+    python scripts/select_defaults.py train --runs runs/selection --frames 4000 --jobs 2
+    python scripts/select_defaults.py score --runs runs/selection --out paper_results/selection
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import trimesh
+from tqdm import tqdm
+
+from common.io import atomic_folder, markdown_table, write_json, write_text
+from common.provenance import git_commit
+from nbv.planning.planners import Planner, PolicyPlanner, make_planner
+from nbv.recon.visibility import visible_coverage
+from nbv.rl.config import EnvConfig, LatticeConfig
+from nbv.rl.env import NBVEnv
+from nbv.viz.figures import plot_seed_scores
+from render.viewpoint import viewpoint_to_c2w
+from scenes.spec import SceneSet
+
+TRAIN_SCENES = ("medieval_tavern", "forest_ruin_house", "random:1", "random:2", "random:3", "random:4")
+VALIDATION_SCENES = ("random:6", "random:7", "random:8")
+BASE = ("--preset", "paper", "--width", "160", "--height", "120", "--spp", "4", "--feature-backend", "opencv",
+        "--lattice", "--relative-step", "0.125", "--threads", "1", "--no-progress")
+CANDIDATES = {
+    "orbit": ("--action-mode", "orbit", "--reward-scale", "0.1"),
+    "absolute": ("--action-mode", "absolute", "--reward-scale", "0.1"),
+    "relative": ("--action-mode", "relative", "--reward-scale", "0.1"),
+    "orbit-alpha0.2": ("--action-mode", "orbit", "--reward-scale", "1"),
+    "orbit-auto-alpha": ("--action-mode", "orbit", "--reward-scale", "1", "--auto-alpha"),
+    "orbit-bands2": ("--action-mode", "orbit", "--reward-scale", "0.1", "--elevation-bands", "2"),
+    "relative-bands2": ("--action-mode", "relative", "--reward-scale", "0.1", "--elevation-bands", "2"),
+}
+"""Flags over the paper preset (Table 1), one factor at a time from `orbit` (the best design measured before):
+the action mode (absolute is the paper's), the entropy setting (fixed alpha 0.2 on raw rewards as in Table 1,
+or learned), and the Bag of Views ranges split into two elevation bands; then the two best factors together
+(`relative-bands2`, added once the first seeds of the others were scored)."""
+
+
+def train_one(run: Path, flags: tuple[str, ...], seed: int, frames: int) -> float:
+    """Train one run (resumes a finished or partial one); return its wall time in seconds."""
+    scenes = [arg for scene in TRAIN_SCENES for arg in ("--scene", scene)]
+    command = ["nbv", "train", *scenes, *BASE, *flags, "--seed", str(seed), "--frames", str(frames),
+               "--checkpoint-every", str(frames), "--out", str(run)]
+    start = time.perf_counter()
+    run.mkdir(parents=True, exist_ok=True)
+    with open(run / "train.log", "a") as log:
+        subprocess.run(command, check=True, stdout=log, stderr=subprocess.STDOUT)
+    return time.perf_counter() - start
+
+
+def train_all(args: argparse.Namespace) -> None:
+    """Every candidate x seed, `--jobs` at a time (seeds interleaved, so a cut run still compares)."""
+    jobs = [(name, seed) for seed, name in itertools.product(args.seeds, args.candidates)]
+    with ThreadPoolExecutor(args.jobs) as pool:
+        futures = {pool.submit(train_one, args.runs / f"{name}-seed{seed}", CANDIDATES[name], seed,
+                               args.frames): (name, seed) for name, seed in jobs}
+        for future, (name, seed) in futures.items():
+            print(f"{name} seed {seed}: {future.result():.0f} s", flush=True)
+
+
+def episode_coverage(planner: Planner, env_config: EnvConfig, scene: str, views: int, seed: int) -> float:
+    """Visible-surface coverage of the true mesh by the planner's `views` viewpoints (exact renders)."""
+    config = replace(env_config, scenes=SceneSet(scene=(scene,)), lattice=LatticeConfig())
+    env = NBVEnv(config, seed=seed)
+    chosen = planner.plan(env, views)
+    loaded = config.scenes.specs()[0].load()
+    occluders = [trimesh.Trimesh(p.vertices, p.faces, process=False) for p in loaded.parts]
+    poses = [viewpoint_to_c2w(v, loaded.center()) for v in chosen]
+    return visible_coverage(occluders, loaded.target_mesh(), config.camera, poses, seed=seed)
+
+
+def validation_score(planner: Planner, env_config: EnvConfig, views: int, episodes: int) -> float:
+    """Mean visible-surface coverage (%) over `VALIDATION_SCENES` x `episodes` start views."""
+    return 100.0 * float(np.mean([episode_coverage(planner, env_config, scene, views, seed)
+                                  for scene in VALIDATION_SCENES for seed in range(episodes)]))
+
+
+def score_all(args: argparse.Namespace) -> None:
+    """Score every finished run and the random and circle baselines; write selection.{json,md,png}."""
+    runs = sorted(p.parent for p in args.runs.glob("*-seed*/checkpoint.pt"))
+    scores: dict[str, dict[int, float]] = {}
+    env_config = None
+    for run in tqdm(runs, desc="score runs", unit="run"):
+        name, seed = run.name.rsplit("-seed", 1)
+        planner = PolicyPlanner(run / "checkpoint.pt")
+        env_config = planner.env_config
+        key = {"views": args.views, "episodes": args.episodes, "scenes": VALIDATION_SCENES,
+               "frames": json.loads((run / "config.json").read_text())["collector"]["frames"]}
+        saved = run / "validation.json"  # a run's score, kept while the protocol and its budget hold
+        if saved.is_file() and json.loads(saved.read_text())["key"] == key:
+            score = json.loads(saved.read_text())["score"]
+        else:
+            score = validation_score(planner, env_config, args.views, args.episodes)
+            write_json(saved, {"key": key, "score": score})
+        scores.setdefault(name, {})[int(seed)] = score
+    baselines = {name: validation_score(make_planner(name, seed=0), env_config, args.views, args.episodes)
+                 for name in ("random", "circle")}
+    rows = [[name, len(by_seed), *(f"{by_seed[s]:.1f}" for s in sorted(by_seed)),
+             f"{np.mean(list(by_seed.values())):.1f} ± {np.std(list(by_seed.values())):.1f}"]
+            for name, by_seed in sorted(scores.items(), key=lambda kv: -np.mean(list(kv[1].values())))]
+    seeds = max(len(v) for v in scores.values())
+    table = (f"Visible-surface coverage (%) of the true mesh, policy mode, {args.views} views, validation "
+             f"buildings {', '.join(VALIDATION_SCENES)} x {args.episodes} start views; "
+             + ", ".join(f"{k} {v:.1f}" for k, v in baselines.items()) + "\n\n"
+             + markdown_table(["candidate", "seeds", *(f"seed {i}" for i in range(seeds)), "mean ± std"],
+                              rows))
+    outputs = ("selection.json", "selection.md", "selection.png")
+    with atomic_folder(args.out, overwrite=True, outputs=outputs) as out:
+        write_text(out / "selection.md", table)
+        plot_seed_scores({k: list(v.values()) for k, v in scores.items()}, out / "selection.png",
+                         "visible coverage % (validation)", "nbv train candidates", baselines)
+        write_json(out / "selection.json", {
+            "commit": git_commit(), "train_scenes": TRAIN_SCENES, "validation_scenes": VALIDATION_SCENES,
+            "views": args.views, "episodes": args.episodes, "base": BASE, "candidates": CANDIDATES,
+            "scores": scores, "baselines": baselines,
+            "frames": {run.name: json.loads((run / "config.json").read_text())["collector"]["frames"]
+                       for run in runs}})
+    print(table)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    train = sub.add_parser("train")
+    train.add_argument("--runs", type=Path, required=True)
+    train.add_argument("--frames", type=int, default=4000)
+    train.add_argument("--jobs", type=int, default=2)
+    train.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    train.add_argument("--candidates", nargs="+", default=list(CANDIDATES), choices=list(CANDIDATES))
+    score = sub.add_parser("score")
+    score.add_argument("--runs", type=Path, required=True)
+    score.add_argument("--out", type=Path, required=True)
+    score.add_argument("--views", type=int, default=13)
+    score.add_argument("--episodes", type=int, default=3)
+    args = parser.parse_args()
+    if args.command == "train":
+        train_all(args)
+    else:
+        score_all(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

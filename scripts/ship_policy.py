@@ -1,0 +1,39 @@
+"""Copy a finished `nbv train` run into the package as the shipped policy (issue 11).
+
+Writes DEST/policy.pt (the actor and config, `weights_only`-loadable), config.json, metrics.csv and
+training.png. The run's output folder in the recorded config is replaced by `--name` (a relative
+path), so no machine path is committed; nothing else changes.
+
+    python scripts/ship_policy.py --run runs/default --dest nbv/planning/shipped --name runs/default
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+from pathlib import Path
+
+from common.io import write_json
+from nbv.rl.checkpoint import load_checkpoint, load_policy, save_policy
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--run", type=Path, required=True)
+    parser.add_argument("--dest", type=Path, required=True)
+    parser.add_argument("--name", default="runs/default")
+    args = parser.parse_args()
+    config, actor = load_policy(args.run / "policy.pt")
+    config["logger"]["out"] = args.name
+    counters = load_checkpoint(args.run / "policy.pt", ("nbv-sac-policy",))["counters"]
+    args.dest.mkdir(parents=True, exist_ok=True)
+    save_policy(args.dest / "policy.pt", json.dumps(config),
+                {f"actor_network_params.{k}": v for k, v in actor.items()}, counters)
+    write_json(args.dest / "config.json", config)
+    for name in ("metrics.csv", "training.png"):
+        shutil.copyfile(args.run / name, args.dest / name)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,58 @@
+"""`nbv online`: runs on disk are read back; margins, speed-up and the one-pass table by hand."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from PIL import Image
+
+from nbv.cli import main
+from nbv.experiments.online import OnlineConfig, run_online, scene_folder
+
+
+def metrics(coverage: float, chamfer: float = 0.5, hausdorff: float = 5.0) -> dict:
+    return {"coverage": coverage, "chamfer_cm": chamfer, "hausdorff_cm": hausdorff}
+
+
+def save_run(folder, views: int, coverage: float, planning_s: float) -> None:
+    folder.mkdir(parents=True)
+    (folder / "plan.json").write_text(json.dumps({
+        "views": views, "gt": metrics(coverage), "reference": metrics(coverage + 0.05, 0.8, 3.0),
+        "planning_s": planning_s + 1.0, "deciding_s": planning_s}))  # 1 s rendering the views flown to
+
+
+def test_online_report_from_saved_runs(tmp_path):
+    # Two buildings, two seeds: the policy covers 80/90 %, random 70, circle 60, greedy 85 (gt).
+    coverage = {"policy-shipped": (0.8, 0.9), "random": (0.7, 0.7), "circle": (0.6, 0.6),
+                "greedy": (0.85, 0.85)}
+    planning = {"policy-shipped": 0.5, "random": 0.0, "circle": 0.0, "greedy": 50.0}
+    for scene in ("alpine_chalet", "random:5"):
+        root = tmp_path / scene_folder(scene)
+        for label, values in coverage.items():
+            for seed in (0, 1):
+                save_run(root / "views13" / f"{label}-seed{seed}", 13, values[seed], planning[label])
+        for seed in (0, 1):
+            save_run(root / "onepass" / f"policy-shipped-seed{seed}", 10 + seed, 0.75, 0.4)
+    config = OnlineConfig(out=tmp_path, scenes=("alpine_chalet", "random:5"), seeds=(0, 1))
+    text = run_online(config)
+    assert "| **mean** | **85.0** | **70.0** | **60.0** | **85.0** |" in text
+    assert "- policy-shipped minus random: +15.0 points" in text
+    assert "- policy-shipped minus greedy: +0.0 points" in text
+    assert "- planning speed-up over greedy (without rendering the views flown to): 100x" in text
+    assert "policy-shipped 1.50 / 0.50" in text
+    row = next(line for line in text.splitlines() if line.startswith("| random:5 (policy-shipped)"))
+    assert row == "| random:5 (policy-shipped) | 10.5 | 80.0 | 3.00 | 0.80 | 75.0 |"
+    assert "| paper Fig. 7 (alpine_chalet) | - | - | 9.47 | 1.01 | - |" in text
+    assert (tmp_path / "online.md").read_text() == text
+    saved = json.loads((tmp_path / "online.json").read_text())
+    assert saved["config"]["seeds"] == [0, 1] and len(saved["budget"]["random:5"]["greedy"]) == 2
+    assert Image.open(tmp_path / "online.png").size[0] > 300
+    assert scene_folder("random:5") == "random_5"
+
+
+def test_online_needs_a_policy_and_a_seed(tmp_path, capsys):
+    with pytest.raises(ValueError, match="at least one scene, one policy and one seed"):
+        OnlineConfig(out=tmp_path, policies=())
+    assert main(["online", "--out", str(tmp_path), "--views", "0"]) == 2
+    assert "views must be >= 1" in capsys.readouterr().err

@@ -15,7 +15,7 @@ import shutil
 from pathlib import Path
 
 from common.io import write_json
-from nbv.rl.checkpoint import load_checkpoint, load_policy, save_policy
+from nbv.rl.checkpoint import POLICY_FORMAT, checkpoint_config, load_checkpoint, save_policy
 
 
 def main() -> None:
@@ -24,12 +24,12 @@ def main() -> None:
     parser.add_argument("--dest", type=Path, required=True)
     parser.add_argument("--name", default="runs/default")
     args = parser.parse_args()
-    config, actor = load_policy(args.run / "policy.pt")
+    state = load_checkpoint(args.run / "policy.pt", (POLICY_FORMAT,))
+    config = checkpoint_config(state, args.run / "policy.pt")
     config["logger"]["out"] = args.name
-    counters = load_checkpoint(args.run / "policy.pt", ("nbv-sac-policy",))["counters"]
     args.dest.mkdir(parents=True, exist_ok=True)
     save_policy(args.dest / "policy.pt", json.dumps(config),
-                {f"actor_network_params.{k}": v for k, v in actor.items()}, counters)
+                {f"actor_network_params.{k}": v for k, v in state["actor"].items()}, state["counters"])
     write_json(args.dest / "config.json", config)
     for name in ("metrics.csv", "training.png"):
         shutil.copyfile(args.run / name, args.dest / name)

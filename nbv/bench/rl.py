@@ -11,15 +11,15 @@ from __future__ import annotations
 import time
 from dataclasses import replace
 
+import numpy as np
 import torch
 from tensordict import TensorDict
-from torchrl.envs.utils import ExplorationType, set_exploration_type
 
 from nbv.bench import BenchResult, temporary_cache
-from nbv.features.sift import extract_features
+from nbv.bench.threads import planning_step_ms
 from nbv.rl.builders import make_environment, make_loss_module, make_sac_agent
 from nbv.rl.config import EnvConfig, LatticeConfig, NetworkConfig, OptimConfig
-from nbv.rl.env import NBVEnv, gray_frame
+from nbv.rl.env import NBVEnv
 from nbv.rl.lattice import build_lattice
 from render.camera import UAVCamera
 from render.renderer import MitsubaRenderer
@@ -69,32 +69,13 @@ def sac_updates_per_s(config: EnvConfig, updates: int, batch: int = 8) -> float:
 
 
 def planning_ms(config: EnvConfig, repeats: int) -> dict[str, float]:
-    """Milliseconds per planning step, by stage, on views rendered beforehand (BoV filling up)."""
+    """Milliseconds per planning step, by stage, on `repeats` views rendered beforehand (BoV filling up)."""
     env = NBVEnv(config, seed=0)
-    td = env.reset()
-    images = [env.render_view(Viewpoint(2.0, 0.7 * i, 0.4)) for i in range(repeats)]
-    actor, _ = make_sac_agent(config, NetworkConfig())
-    features = config.bov.feature_config()
-    bov = config.bov.bag()
-    with torch.no_grad(), set_exploration_type(ExplorationType.DETERMINISTIC):
-        actor(td.clone())  # warm-up
-    extract_features([images[0]], features)
-    totals = {"features": 0.0, "bov": 0.0, "policy": 0.0}
-    with torch.no_grad(), set_exploration_type(ExplorationType.DETERMINISTIC):
-        for i, rgb in enumerate(images):
-            t0 = time.perf_counter()
-            descriptors = extract_features([rgb], features)[0].descriptors
-            t1 = time.perf_counter()
-            bov.reward(descriptors, 0.7 * i)
-            t2 = time.perf_counter()
-            frame = torch.from_numpy(gray_frame(rgb, config.obs_size))
-            td["pixels"] = torch.cat([td["pixels"][1:], frame[None]])
-            actor(td)
-            t3 = time.perf_counter()
-            totals["features"] += t1 - t0
-            totals["bov"] += t2 - t1
-            totals["policy"] += t3 - t2
-    return {k: 1000.0 * v / len(images) for k, v in totals.items()}
+    env.reset()
+    images = np.stack([env.render_view(Viewpoint(2.0, 0.7 * i, 0.4)) for i in range(repeats)])
+    stages = planning_step_ms(images, config, 1)
+    del stages["total"]
+    return stages
 
 
 def lattice_vs_render(config: EnvConfig, steps: int) -> list[BenchResult]:

@@ -67,6 +67,16 @@ def test_two_worker_cli_run_writes_checkpoint_and_resumes(tmp_path):
     assert Image.open(run / "training.png").size[0] > 500
 
 
+def replay_sample(config: TrainConfig, rewards: torch.Tensor) -> TensorDict:
+    """A replay batch of identical grey states and zero actions with the given (n, 1) rewards."""
+    n, side = len(rewards), config.env.obs_size
+    state = {"pixels": torch.full((n, 5, side, side), 100, dtype=torch.uint8),
+             "viewpoints": torch.zeros(n, 5, 3)}
+    return TensorDict({**state, "action": torch.zeros(n, 3), "next": TensorDict({
+        **state, "reward": rewards, "done": torch.zeros(n, 1, dtype=torch.bool),
+        "terminated": torch.zeros(n, 1, dtype=torch.bool)}, [n])}, [n])
+
+
 def test_reward_scale_is_the_same_update_as_scaled_rewards():
     config = tiny(None, 10)
 
@@ -75,13 +85,7 @@ def test_reward_scale_is_the_same_update_as_scaled_rewards():
         actor, critic = make_sac_agent(config.env, config.network)
         loss, _ = make_loss_module(actor, critic, config.optim)
         optim_actor, optim_critic = make_optimizers(loss, config.optim)
-        n, side = 4, config.env.obs_size
-        state = {"pixels": torch.full((n, 5, side, side), 100, dtype=torch.uint8),
-                 "viewpoints": torch.zeros(n, 5, 3)}
-        sample = TensorDict({**state, "action": torch.zeros(n, 3), "next": TensorDict({
-            **state, "reward": torch.arange(n, dtype=torch.float32)[:, None] * rewards_times,
-            "done": torch.zeros(n, 1, dtype=torch.bool), "terminated": torch.zeros(n, 1, dtype=torch.bool)},
-            [n])}, [n])
+        sample = replay_sample(config, torch.arange(4, dtype=torch.float32)[:, None] * rewards_times)
         sac_update(loss, optim_actor, optim_critic, sample, reward_scale)
         return [p.detach().clone() for p in loss.qvalue_network_params.values(True, True)]
 
@@ -97,12 +101,7 @@ def test_auto_alpha_learns_the_temperature_and_fixed_alpha_keeps_it():
         actor, critic = make_sac_agent(config.env, config.network)
         loss, _ = make_loss_module(actor, critic, config.optim)
         optim_actor, optim_critic = make_optimizers(loss, config.optim)
-        n, side = 4, config.env.obs_size
-        state = {"pixels": torch.full((n, 5, side, side), 100, dtype=torch.uint8),
-                 "viewpoints": torch.zeros(n, 5, 3)}
-        sample = TensorDict({**state, "action": torch.zeros(n, 3), "next": TensorDict({
-            **state, "reward": torch.ones(n, 1), "done": torch.zeros(n, 1, dtype=torch.bool),
-            "terminated": torch.zeros(n, 1, dtype=torch.bool)}, [n])}, [n])
+        sample = replay_sample(config, torch.ones(4, 1))
         return [sac_update(loss, optim_actor, optim_critic, sample.clone())["alpha"] for _ in range(3)]
 
     assert alphas(False) == pytest.approx([0.2] * 3)

@@ -135,15 +135,21 @@ def online_report(budget: dict[str, dict[str, list[dict]]], one_pass: dict[str, 
              f"{config.views} views, mean over seeds {', '.join(map(str, config.seeds))}; "
              "policies act on their mode.", "",
              markdown_table(["building", *labels], rows), "",
-             "Planning time per scan, s (all / without rendering the views flown to, `plan.json`'s "
-             "`planning_s` / `deciding_s`): "
+             "Planning time per scan, s (all / without the simulated camera, i.e. loading the scene into "
+             "the renderer and rendering the views flown to; `plan.json`'s `planning_s` / `deciding_s`): "
              + ", ".join(f"{label} {planning[label]:.2f} / {deciding[label]:.2f}" for label in labels), ""]
     for other in ("random", "circle", "greedy"):
         if other in overall and policy in overall:
             lines.append(f"- {policy} minus {other}: {overall[policy] - overall[other]:+.1f} points")
     if "greedy" in deciding and policy in deciding:
-        lines.append("- planning speed-up over greedy (without rendering the views flown to): "
+        lines.append("- planning speed-up over greedy (without the simulated camera): "
                      f"{deciding['greedy'] / deciding[policy]:.0f}x")
+    policies = [planner_label(spec) for spec in config.policies]
+    if len(policies) > 1 and all(label in overall for label in policies):
+        spread = [overall[label] for label in policies]
+        lines.append(f"- spread over the {len(policies)} policies (training seeds): "
+                     f"{max(spread) - min(spread):.1f} points ("
+                     + ", ".join(f"{label} {overall[label]:.1f}" for label in policies) + ")")
     if one_pass:
         lines += ["", "## One pass around the target (the paper's protocol), against the full 288-view scan",
                   "", _one_pass_table(one_pass, policy)]

@@ -121,8 +121,9 @@ def planning_env_config(config: PlanConfig, planner: Planner) -> EnvConfig:
 def choose_views(config: PlanConfig, planner: Planner,
                  env_config: EnvConfig) -> tuple[list[Viewpoint], float, float]:
     """The planner's viewpoints, the planning wall time in seconds (renders included) and the part of it
-    spent rendering the views flown to (the mean render time of a view times their count: images a real
-    camera captures anyway; greedy's other candidate renders stay planning time).
+    spent simulating the camera: loading the scene into the renderer, and rendering the views flown to
+    (the mean render time of a view times their count), images a real camera captures anyway. Greedy's
+    other candidate renders stay planning time.
 
     Torch runs on the thread policy's count (`common.threads.worker_threads`, 1) while planning, unless
     this process already chose its threads; the previous count is restored afterwards.
@@ -134,7 +135,7 @@ def choose_views(config: PlanConfig, planner: Planner,
         views = planner.plan(env, config.views)
         seconds = time.perf_counter() - start
     rendered = env.render_seconds / max(env.views_rendered, 1) * len(views) if env.views_rendered else 0.0
-    return views, seconds, min(rendered, seconds)
+    return views, seconds, min(env.setup_seconds + rendered, seconds)
 
 
 def reference_mesh(config: PlanConfig, scene: Scene | None = None) -> Path:
@@ -142,14 +143,14 @@ def reference_mesh(config: PlanConfig, scene: Scene | None = None) -> Path:
 
     The scan comes from `render.scan_cache.full_scan`, re-rendered only when the scene, camera or
     settings change (a re-rendered scan replaces its folder, the stale reconstruction with it); the
-    reconstruction is redone when its settings (`RECONSTRUCTION_KEY`) change.
+    reconstruction is redone when its settings (`RECONSTRUCTION_KEY`) change. The scan renders at the
+    plan's render settings with their own seed, not the run's: every seed is scored against one reference.
     """
     if config.reference is not None:
         return Path(config.reference)
     env_config = scan_env_config(config)
     radius = (env_config.radius_min + env_config.radius_max) / 2.0
-    settings = replace(config.render, seed=config.seed)
-    full = full_scan(scene or config.scene.load(), config.camera, settings=settings,
+    full = full_scan(scene or config.scene.load(), config.camera, settings=config.render,
                      variant=config.render.variant, plan=HemispherePlan(radius=radius), progress=False)
     folder = full.root / f"reconstruction_{config.recon.voxel_size_m * 1000:g}mm"
     key = config_record(config.recon)
@@ -173,7 +174,7 @@ def plan_scan(config: PlanConfig) -> dict:
     out = Path(config.out)
     check_output_folder(out, config.overwrite)
     planner = make_planner(config.planner, config.seed, config.candidates)
-    views, plan_s, flown_render_s = choose_views(config, planner, planning_env_config(config, planner))
+    views, plan_s, camera_s = choose_views(config, planner, planning_env_config(config, planner))
     scene = config.scene.load()
     settings = replace(config.render, seed=config.seed)
     meta = {"planner": config.planner, "up_axis": config.scene.up_axis}
@@ -192,7 +193,7 @@ def plan_scan(config: PlanConfig) -> dict:
             references["reference"] = load_geometry(reference, "reference")
         results = write_evaluation(evaluation, load_geometry(folder / "mesh.ply", "mesh"), references, folder)
         doc = {"planner": config.planner, "scene": config.scene.scene, "views": len(views),
-               "planning_s": plan_s, "deciding_s": plan_s - flown_render_s,
+               "planning_s": plan_s, "deciding_s": plan_s - camera_s,
                "viewpoints": [v.as_array().tolist() for v in views],
                "config": config_record(config),
                **{name: result.as_dict() for name, result in results.items()}}

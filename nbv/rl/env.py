@@ -159,6 +159,7 @@ class NBVEnv(EnvBase):
         self._episode = 0
         self._views_rendered = 0
         self.render_seconds = 0.0  # wall time of those renders (planning time without renders)
+        self.setup_seconds = 0.0  # wall time loading scenes into renderers (camera setup)
         self._bov = None
 
     def _reset(self, tensordict: TensorDictBase | None = None, **kwargs) -> TensorDictBase:
@@ -271,7 +272,9 @@ class NBVEnv(EnvBase):
 
     def _renderer(self, spec: SceneSpec) -> MitsubaRenderer:
         if spec.scene not in self._renderers:
+            start = time.perf_counter()
             self._renderers[spec.scene] = MitsubaRenderer(self._load(spec), self.config.camera, self._render)
+            self.setup_seconds += time.perf_counter() - start
         return self._renderers[spec.scene]
 
     def _load(self, spec: SceneSpec) -> Scene:

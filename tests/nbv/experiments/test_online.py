@@ -23,10 +23,11 @@ def save_run(folder, views: int, coverage: float, planning_s: float) -> None:
 
 
 def test_online_report_from_saved_runs(tmp_path):
-    # Two buildings, two seeds: the policy covers 80/90 %, random 70, circle 60, greedy 85 (gt).
-    coverage = {"policy-shipped": (0.8, 0.9), "random": (0.7, 0.7), "circle": (0.6, 0.6),
-                "greedy": (0.85, 0.85)}
-    planning = {"policy-shipped": 0.5, "random": 0.0, "circle": 0.0, "greedy": 50.0}
+    # Two buildings, two seeds: the policy covers 80/90 %, another seed's 70/80, random 70, circle 60,
+    # greedy 85 (gt).
+    coverage = {"policy-shipped": (0.8, 0.9), "policy-seed1": (0.7, 0.8), "random": (0.7, 0.7),
+                "circle": (0.6, 0.6), "greedy": (0.85, 0.85)}
+    planning = {"policy-shipped": 0.5, "policy-seed1": 0.5, "random": 0.0, "circle": 0.0, "greedy": 50.0}
     for scene in ("alpine_chalet", "random:5"):
         root = tmp_path / scene_folder(scene)
         for label, values in coverage.items():
@@ -34,12 +35,16 @@ def test_online_report_from_saved_runs(tmp_path):
                 save_run(root / "views13" / f"{label}-seed{seed}", 13, values[seed], planning[label])
         for seed in (0, 1):
             save_run(root / "onepass" / f"policy-shipped-seed{seed}", 10 + seed, 0.75, 0.4)
-    config = OnlineConfig(out=tmp_path, scenes=("alpine_chalet", "random:5"), seeds=(0, 1))
+    config = OnlineConfig(out=tmp_path, scenes=("alpine_chalet", "random:5"), seeds=(0, 1),
+                          policies=("policy", f"policy:{tmp_path / 'seed1' / 'policy.pt'}"))
     text = run_online(config)
-    assert "| **mean** | **85.0** | **70.0** | **60.0** | **85.0** |" in text
+    assert "| **mean** | **85.0** | **75.0** | **70.0** | **60.0** | **85.0** |" in text
     assert "- policy-shipped minus random: +15.0 points" in text
     assert "- policy-shipped minus greedy: +0.0 points" in text
-    assert "- planning speed-up over greedy (without rendering the views flown to): 100x" in text
+    assert "- planning speed-up over greedy (without the simulated camera): 100x" in text
+    spread = ("- spread over the 2 policies (training seeds): 10.0 points "
+              "(policy-shipped 85.0, policy-seed1 75.0)")
+    assert spread in text
     assert "policy-shipped 1.50 / 0.50" in text
     row = next(line for line in text.splitlines() if line.startswith("| random:5 (policy-shipped)"))
     assert row == "| random:5 (policy-shipped) | 10.5 | 80.0 | 3.00 | 0.80 | 75.0 |"

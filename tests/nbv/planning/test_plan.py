@@ -5,6 +5,8 @@ from __future__ import annotations
 import json
 from dataclasses import replace
 
+import pytest
+
 from nbv.bov.config import BoVConfig
 from nbv.cli import main
 from nbv.planning.plan import PlanConfig, planning_env_config, reference_mesh
@@ -14,6 +16,7 @@ from nbv.rl.env import NBVEnv
 from render.camera import UAVCamera
 from render.dataset import read_dataset
 from render.settings import RenderSettings
+from render.viewpoint import Viewpoint
 from scenes import load_scene
 from scenes.spec import SceneSet, SceneSpec
 
@@ -54,6 +57,7 @@ def test_reference_is_the_cached_full_scan_reconstruction(tmp_path):
     assert len(read_dataset(path.parent.parent)) == 288  # the paper's full hemisphere scan
     stamp = path.stat().st_mtime_ns
     assert reference_mesh(config) == path and path.stat().st_mtime_ns == stamp  # reused, not rebuilt
+    assert reference_mesh(replace(config, seed=3)) == path and path.stat().st_mtime_ns == stamp  # seed-free
     other = replace(config, recon=replace(config.recon, truncation_m=0.06))
     assert reference_mesh(other) == path and path.stat().st_mtime_ns != stamp  # other fusion settings: redone
 
@@ -89,3 +93,23 @@ def test_choose_views_plans_on_the_thread_policy_and_restores_torch(tmp_path, mo
         assert seen == [threads.worker_threads(), 2] and torch.get_num_threads() == 2
     finally:
         torch.set_num_threads(before)
+
+
+def test_choose_views_counts_the_simulated_camera_apart_from_deciding(tmp_path):
+    from nbv.planning.plan import choose_views, scan_env_config
+
+    class Looker:  # renders 3 candidates beside its start view, flies to one view
+        def plan(self, env, views):
+            self.env = env
+            env.reset()
+            for azimuth in (0.5, 1.5, 2.5):
+                env.render_view(Viewpoint(env.viewpoint.radius, azimuth, env.viewpoint.elevation))
+            return [env.viewpoint]
+
+    config = PlanConfig(scene=SceneSpec(scene="test_building"), out=tmp_path, camera=UAVCamera(48, 36),
+                        render=RenderSettings(spp=1))
+    looker = Looker()
+    views, seconds, camera = choose_views(config, looker, scan_env_config(config))
+    env = looker.env
+    assert len(views) == 1 and env.views_rendered == 4 and env.setup_seconds > 0
+    assert camera == pytest.approx(env.setup_seconds + env.render_seconds / 4) and camera < seconds

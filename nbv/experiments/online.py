@@ -100,6 +100,13 @@ def run_online(config: OnlineConfig) -> str:
     return text
 
 
+def rerun_command(config: OnlineConfig) -> str:
+    """The `nbv online` command line that re-runs `config`'s evaluation (its output folder left as DIR)."""
+    return (f"nbv online --scenes {' '.join(config.scenes)} --policies {' '.join(config.policies)} "
+            f"--baselines {' '.join(config.baselines)} --seeds {' '.join(map(str, config.seeds))} "
+            f"--views {config.views} --out DIR")
+
+
 def _runs(folder: Path) -> dict[str, list[dict]]:
     doc = json.loads((folder / "comparison.json").read_text())
     by_planner: dict[str, list[dict]] = {}
@@ -134,6 +141,7 @@ def online_report(budget: dict[str, dict[str, list[dict]]], one_pass: dict[str, 
              f"Coverage (%) of the true surface within {config.metrics.threshold_cm:g} cm, "
              f"{config.views} views, mean over seeds {', '.join(map(str, config.seeds))}; "
              "policies act on their mode.", "",
+             f"Re-run: `{rerun_command(config)}`", "",
              markdown_table(["building", *labels], rows), "",
              "Planning time per scan, s (all / without the simulated camera, i.e. loading the scene into "
              "the renderer and rendering the views flown to; `plan.json`'s `planning_s` / `deciding_s`): "

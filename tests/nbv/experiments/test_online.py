@@ -41,6 +41,9 @@ def test_online_report_from_saved_runs(tmp_path):
     assert "| **mean** | **85.0** | **75.0** | **70.0** | **60.0** | **85.0** |" in text
     assert "- policy-shipped minus random: +15.0 points" in text
     assert "- policy-shipped minus greedy: +0.0 points" in text
+    assert ("Re-run: `nbv online --scenes alpine_chalet random:5 --policies policy "
+            f"policy:{tmp_path}/seed1/policy.pt --baselines random circle greedy --seeds 0 1 --views 13 "
+            "--out DIR`") in text
     assert "- planning speed-up over greedy (without the simulated camera): 100x" in text
     spread = ("- spread over the 2 policies (training seeds): 10.0 points "
               "(policy-shipped 85.0, policy-seed1 75.0)")

@@ -15,7 +15,8 @@ The RGB pass follows `RenderSettings`: pixel filter, integrator, spp, lighting
 (`RenderSettings.render_camera`: the lens is kept, so the field of view is).
 Its linear output goes through `render.postprocess` (denoise, exposure, noise,
 sRGB, JPEG); with the denoiser on, a third pass renders its albedo and normal
-guides at the RGB pass's spp, filter and seed.
+guides at the RGB pass's spp, filter and seed. With motion blur, both are the
+mean over sub-frame poses (`render.motion_blur`); depth stays at the view's pose.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ import numpy as np
 
 from render.camera import UAVCamera
 from render.lighting import scene_emitters
+from render.motion_blur import subframe_poses
 from render.postprocess import postprocess
 from render.settings import LightingSettings, RenderSettings
 from render.texture_scale import texture_dict
@@ -85,16 +87,27 @@ class MitsubaRenderer:
         if seed is None:
             seed = self.settings.view_seed(self._views_rendered)
         self._views_rendered += 1
-        spp = self.settings.spp
-        sensor = self._sensor(pose, self.settings.rgb_filter, {"type": "independent"}, spp)
-        image = self.mi.render(self._scene, sensor=sensor, integrator=self._rgb_integrator, spp=spp,
-                               seed=int(seed))
+        poses = subframe_poses(pose, self.settings.motion_blur_m, self.settings.motion_blur_frames)
+        image = self._mean_pass(poses, int(seed), self._rgb_integrator)
         albedo = normal = None
         if self.settings.denoiser != "off":
-            guides = np.asarray(self.mi.render(self._scene, sensor=sensor, integrator=self._guide_integrator,
-                                               spp=spp, seed=int(seed)))
+            guides = self._mean_pass(poses, int(seed), self._guide_integrator)
             albedo, normal = guides[..., 0:3], guides[..., 3:6]
-        return postprocess(np.asarray(image)[..., :3], self.settings, int(seed), albedo, normal)
+        return postprocess(image[..., :3], self.settings, int(seed), albedo, normal)
+
+    def _mean_pass(self, poses: list[np.ndarray], seed: int, integrator) -> np.ndarray:
+        """One RGB-sensor pass of `integrator`: at one pose as rendered, over motion-blur sub-frames their
+        mean, sub-frame k seeded `seed * frames + k` with `spp // frames` samples (at least 1)."""
+        if len(poses) == 1:
+            spp, seeds = self.settings.spp, [seed]
+        else:
+            spp = max(1, self.settings.spp // len(poses))
+            seeds = [(seed * len(poses) + k) % 2**32 for k in range(len(poses))]
+        images = [np.asarray(self.mi.render(self._scene, integrator=integrator, spp=spp, seed=s,
+                                            sensor=self._sensor(p, self.settings.rgb_filter,
+                                                                {"type": "independent"}, spp)))
+                  for p, s in zip(poses, seeds)]
+        return images[0] if len(images) == 1 else np.mean(images, axis=0, dtype=np.float32)
 
     def _depth(self, pose: np.ndarray) -> np.ndarray:
         sampler = {"type": "stratified", "jitter": False}

@@ -1,7 +1,7 @@
 """How views are rendered: the render config every command that renders nests (one declaration).
 
 `RenderSettings` holds the light transport (spp, integrator, pixel filter,
-denoiser, resolution, texture detail) and nests the lighting (`LightingSettings`)
+denoiser, resolution, texture detail, motion blur) and nests the lighting (`LightingSettings`)
 and the simulated sensor (`SensorSettings`). Every default reproduces the renders
 made before these settings existed, bit for bit; the post-processing order is
 documented in `render.postprocess`. Flags are flat (`nbv.cli.parse`): `--spp`,
@@ -23,6 +23,8 @@ MAX_SPP = 65_536
 """Most samples per pixel (Mitsuba's samplers refuse counts near 2^32; 64k is far past converged)."""
 MAX_RESOLUTION_SCALE = 8.0
 """Largest resolution scale (a 320x240 camera renders at most 2560x1920)."""
+MAX_BLUR_FRAMES = 64
+"""Most motion-blur sub-frames (each is a render)."""
 MAX_EXPOSURE_STOPS = 20.0
 """Largest exposure change either way, stops (2^20 is a million times brighter or darker)."""
 
@@ -119,6 +121,10 @@ class RenderSettings:
     """Render at this multiple of the camera's width and height, field of view kept, in (0, 8]."""
     texture_scale: float = 1.0
     """Downsample every scene texture to this fraction of its width and height, in (0, 1]."""
+    motion_blur_m: float = 0.0
+    """Camera travel while the shutter is open, metres sideways (camera x), in [0, 1]; 0: no motion blur."""
+    motion_blur_frames: int = 8
+    """Sub-frame poses averaged for motion blur, in [2, 64]; each renders spp / frames samples (min 1)."""
     lighting: LightingSettings = LightingSettings()
     """Sun and sky."""
     sensor: SensorSettings = SensorSettings()
@@ -143,6 +149,10 @@ class RenderSettings:
         _check_choice("denoiser", self.denoiser, Denoiser)
         _check_number("resolution_scale", self.resolution_scale, 0.0, MAX_RESOLUTION_SCALE, low_open=True)
         _check_number("texture_scale", self.texture_scale, 0.0, 1.0, low_open=True)
+        _check_number("motion_blur_m", self.motion_blur_m, 0.0, 1.0)
+        frames = self.motion_blur_frames
+        if isinstance(frames, bool) or not isinstance(frames, int) or not 2 <= frames <= MAX_BLUR_FRAMES:
+            raise ValueError(f"motion_blur_frames must be in 2..{MAX_BLUR_FRAMES}, got {frames!r}")
 
     def view_seed(self, index: int) -> int:
         """The per-view seed of view `index` (Mitsuba uses seed 0 unless told)."""

@@ -20,6 +20,7 @@ from render.settings import LightingSettings, RenderSettings, SensorSettings
 from render.texture_scale import texture_dict
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes import load_scene
+from scenes.model import Lighting, Material, Part, Scene
 
 CAMERA = UAVCamera(64, 48)
 VIEW = Viewpoint(2.0, 0.8, 0.5)
@@ -117,6 +118,40 @@ def test_a_downsampled_texture_keeps_its_linear_mean(scene):
     assert texture_dict(mi, path) == {"type": "bitmap", "filename": str(path), "wrap_mode": "repeat"}
 
 
+def marker_scene():
+    """A grey floor with a red 10 cm square at the origin, lit from straight above."""
+    def quad(name, half, color, z=0.0):
+        corners = np.array([[-half, -half, z], [half, -half, z], [half, half, z], [-half, half, z]], float)
+        return Part(name, corners, np.array([[0, 1, 2], [0, 2, 3]]), Material(name, color=color))
+    return Scene("marker", (quad("floor", 2.0, (0.5, 0.5, 0.5)), quad("red", 0.05, (1.0, 0.0, 0.0), 1e-3)),
+                 Lighting(sun_elevation_deg=90.0))
+
+
+def red_spread(image):
+    """Centroid (x, y) and variance (x, y) in pixels^2 of the image's redness."""
+    weight = np.clip(image[..., 0].astype(float) - image[..., 1], 0, None)
+    ys, xs = np.mgrid[:image.shape[0], :image.shape[1]]
+    centre = [(weight * c).sum() / weight.sum() for c in (xs, ys)]
+    return centre, [(weight * (c - m) ** 2).sum() / weight.sum() for c, m in zip((xs, ys), centre)]
+
+
+def test_motion_blur_smears_along_the_camera_x_axis():
+    camera, travel = UAVCamera(96, 72), 0.1
+    c2w = viewpoint_to_c2w(Viewpoint(1.5, 0.3, 1.2), np.zeros(3))
+    sharp = MitsubaRenderer(marker_scene(), camera)
+    blurred = MitsubaRenderer(marker_scene(), camera, RenderSettings(motion_blur_m=travel))
+    centre, spread = red_spread(sharp.render_rgb(c2w, seed=1))
+    blur_centre, blur_spread = red_spread(blurred.render_rgb(c2w, seed=1))
+    # 8 sub-frames evenly over L = travel * fx / z pixels add L^2 (K^2 - 1) / (12 K^2) to the x variance
+    # (z: the marker's depth); y and the centroid stay.
+    z = sharp.render_depth(c2w)[int(round(centre[1])), int(round(centre[0]))]
+    length = travel * camera.fx / z
+    assert blur_spread[0] - spread[0] == pytest.approx(length**2 * 63 / (12 * 64), rel=0.15)
+    assert blur_spread[1] == pytest.approx(spread[1], abs=0.3)
+    np.testing.assert_allclose(blur_centre, centre, atol=0.2)
+    np.testing.assert_array_equal(blurred.render_depth(c2w), sharp.render_depth(c2w))  # at the view's pose
+
+
 def test_lighting_modes_light_the_scene_as_named(scene):
     both = rgb(scene).astype(float)
     hard = rgb(scene, RenderSettings(lighting=LightingSettings(light_mode="hard_sun"))).astype(float)
@@ -156,7 +191,6 @@ def test_settings_are_recorded_in_transforms_json(scene, tmp_path):
 
 
 def test_a_mitsuba_xml_scene_refuses_lighting_settings(tmp_path):
-    from scenes.model import Scene
     xml = tmp_path / "scene.xml"
     xml.write_text('<scene version="3.0.0"><emitter type="constant"/></scene>')
     with pytest.raises(ValueError, match="lighting settings and texture_scale do not apply"):

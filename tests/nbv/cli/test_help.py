@@ -15,9 +15,9 @@ def test_help_builds_and_exits_0(name, capsys):
 
 @pytest.mark.parametrize("name, flags", [
     ("scan", ["--width", "--spp", "--up-axis", "--seed", "--variant", "--denoiser", "--pixel-filter",
-              "--resolution-scale", "--texture-scale", "--sky-model", "--light-mode", "--sun-elevation-deg",
-              "--sun-azimuth-deg", "--turbidity", "--exposure-stops", "--shot-noise", "--read-noise",
-              "--jpeg-quality"]),
+              "--resolution-scale", "--texture-scale", "--motion-blur-m", "--motion-blur-frames",
+              "--sky-model", "--light-mode", "--sun-elevation-deg", "--sun-azimuth-deg", "--turbidity",
+              "--exposure-stops", "--shot-noise", "--read-noise", "--jpeg-quality"]),
     ("plan", ["--planner", "--views", "--match-cosine", "--up-axis", "--focal-mm", "--metric-points",
               "--denoiser", "--jpeg-quality", "--sky-model"]),
     ("train", ["--scene", "--frames", "--bov-ranges", "--feature-backend", "--match-cosine", "--up-axis",

@@ -22,7 +22,7 @@ def test_scan_takes_every_render_setting_as_a_flag_and_records_it(tmp_path):
     out = tmp_path / "ds"
     assert main(["scan", "test_building", "--plan", "circle", "--views", "2", "--width", "32",
                  "--height", "24", "--spp", "2", "--pixel-filter", "tent", "--resolution-scale", "1.5",
-                 "--texture-scale", "0.5",
+                 "--texture-scale", "0.5", "--motion-blur-m", "0.02", "--motion-blur-frames", "2",
                  "--sky-model", "sunsky", "--light-mode", "overcast", "--sun-elevation-deg", "30",
                  "--sun-azimuth-deg", "100", "--turbidity", "4", "--exposure-stops", "0.5",
                  "--shot-noise", "0.001", "--read-noise", "0.002", "--jpeg-quality", "70",
@@ -31,6 +31,7 @@ def test_scan_takes_every_render_setting_as_a_flag_and_records_it(tmp_path):
     assert (doc["w"], doc["h"]) == (48, 36)
     render = doc["nbv"]["render"]
     assert (render["pixel_filter"], render["resolution_scale"], render["texture_scale"]) == ("tent", 1.5, 0.5)
+    assert (render["motion_blur_m"], render["motion_blur_frames"]) == (0.02, 2)
     assert render["lighting"] == {"sky_model": "sunsky", "light_mode": "overcast", "sun_elevation_deg": 30.0,
                                   "sun_azimuth_deg": 100.0, "turbidity": 4.0}
     assert render["sensor"] == {"exposure_stops": 0.5, "shot_noise": 0.001, "read_noise": 0.002,
@@ -53,6 +54,7 @@ def test_scene_list_and_export(tmp_path, capsys):
     (["test_building", "--jpeg-quality", "0"], "jpeg_quality must be in 1..100, got 0"),
     (["test_building", "--resolution-scale", "0"], "resolution_scale"),
     (["test_building", "--texture-scale", "2"], "texture_scale"),
+    (["test_building", "--motion-blur-frames", "1"], "motion_blur_frames"),
     (["test_building", "--sun-elevation-deg", "-5"], "sun_elevation_deg"),
     (["test_building", "--turbidity", "20"], "turbidity"),
     (["test_building", "--shot-noise", "nan"], "shot_noise"),

@@ -1,11 +1,11 @@
 """How views are rendered: the render config every command that renders nests (one declaration).
 
 `RenderSettings` holds the light transport (spp, integrator, pixel filter,
-denoiser, resolution, texture detail, motion blur) and nests the lighting (`LightingSettings`)
-and the simulated sensor (`SensorSettings`). Every default reproduces the renders
-made before these settings existed, bit for bit; the post-processing order is
-documented in `render.postprocess`. Flags are flat (`nbv.cli.parse`): `--spp`,
-`--light-mode`, `--jpeg-quality`, ...
+denoiser, resolution, texture detail, motion blur) and nests the lighting
+(`LightingSettings`) and the simulated sensor (`SensorSettings`). Every default
+reproduces the renders made before these settings existed, bit for bit; the
+post-processing order is documented in `render.postprocess`. Flags are flat
+(`nbv.cli.parse`): `--spp`, `--light-mode`, `--jpeg-quality`, ...
 """
 
 from __future__ import annotations

@@ -38,3 +38,19 @@ def test_mismatched_or_tiny_images_are_refused():
         psnr(np.zeros((4, 4), np.uint8), np.zeros((4, 4), np.float32))
     with pytest.raises(ValueError, match="at least 11"):
         ssim(np.zeros((8, 8), np.uint8), np.zeros((8, 8), np.uint8))
+
+
+def test_ssim_and_psnr_agree_with_kornia():
+    torch = pytest.importorskip("torch")
+    kornia = pytest.importorskip("kornia")
+    rng = np.random.default_rng(1)
+    image = rng.integers(0, 256, (40, 50, 3)).astype(np.uint8)
+    noisy = np.clip(image + rng.normal(0, 25, image.shape), 0, 255).astype(np.uint8)
+
+    def tensor(x):
+        return torch.from_numpy(x.astype(np.float32) / 255).permute(2, 0, 1)[None]
+
+    expected = kornia.metrics.ssim(tensor(noisy), tensor(image), 11, padding="valid").mean().item()
+    assert ssim(noisy, image) == pytest.approx(expected, abs=1e-6)
+    assert psnr(noisy, image) == pytest.approx(kornia.metrics.psnr(tensor(noisy), tensor(image), 1.0).item(),
+                                               abs=1e-4)

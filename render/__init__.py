@@ -1,4 +1,4 @@
-"""The UAV camera: intrinsics, poses, Mitsuba rendering, scan plans, view datasets, scan cache.
+"""The UAV camera: intrinsics, poses, Mitsuba rendering and settings, scan plans, view datasets, scan cache.
 
 Mitsuba is imported lazily (by `render.renderer`), after the variant and the
 libLLVM path are chosen in `render.variant`; names are re-exported lazily too.
@@ -10,7 +10,9 @@ _EXPORTS = {
     "UAVCamera": "render.camera",
     "Viewpoint": "render.viewpoint", "c2w_to_viewpoint": "render.viewpoint",
     "viewpoint_to_c2w": "render.viewpoint",
-    "RenderSettings": "render.settings",
+    "RenderSettings": "render.settings", "LightingSettings": "render.settings",
+    "SensorSettings": "render.settings",
+    "postprocess": "render.postprocess", "psnr": "render.quality", "ssim": "render.quality",
     "MitsubaRenderer": "render.renderer",
     "CirclePlan": "render.scan", "HemispherePlan": "render.scan", "ScanConfig": "render.scan",
     "circle_scan": "render.scan", "hemisphere_scan": "render.scan",

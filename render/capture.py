@@ -25,8 +25,10 @@ def capture_dataset(scene: Scene, camera: UAVCamera, viewpoints: Sequence[Viewpo
     """Render `viewpoints` of `scene` and write them atomically as a dataset at `out`.
 
     View i is rendered with seed `settings.view_seed(i)`, so a dataset is
-    reproducible bit for bit on the same machine and variant. An interruption
-    leaves nothing at `out` (or the previous content, with `overwrite`).
+    reproducible bit for bit on the same machine and variant. Images have the
+    camera's size times `settings.resolution_scale` (field of view kept), and the
+    dataset records that camera. An interruption leaves nothing at `out` (or the
+    previous content, with `overwrite`).
     """
     if not viewpoints:
         raise ValueError("a scan needs at least one viewpoint")
@@ -34,7 +36,7 @@ def capture_dataset(scene: Scene, camera: UAVCamera, viewpoints: Sequence[Viewpo
     renderer = MitsubaRenderer(scene, camera, settings, variant)
     doc = {"scene": scene.name, "center": renderer.center.tolist(), "variant": renderer.variant,
            "render": asdict(settings), "seed": settings.seed, **(meta or {})}
-    with DatasetWriter(out, camera, doc, overwrite) as writer:
+    with DatasetWriter(out, renderer.camera, doc, overwrite) as writer:
         for i, view in enumerate(tqdm(viewpoints, desc=f"scan {scene.name}", unit="view",
                                       disable=not progress)):
             c2w = viewpoint_to_c2w(view, renderer.center)

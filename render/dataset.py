@@ -35,9 +35,11 @@ from render.dataset_read import (
     read_document,
     read_png,
     read_pose,
+    read_render_settings,
     read_viewpoint,
     typed_field,
 )
+from render.settings import RenderSettings
 from render.viewpoint import Viewpoint, opencv_to_opengl, validate_pose
 
 APPLIED_TRANSFORM = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]]
@@ -71,7 +73,8 @@ class ViewDataset:
     frames: tuple[Frame, ...]
     """Frames in capture order."""
     meta: dict[str, Any]
-    """The top-level `nbv` fields: scene, centre, render settings, seed, plan."""
+    """The top-level `nbv` fields: scene, centre, render settings (`render_settings` parses them), seed,
+    plan."""
 
     def __len__(self) -> int:
         return len(self.frames)
@@ -80,6 +83,11 @@ class ViewDataset:
     def center(self) -> np.ndarray:
         """The scene centre the viewpoints are relative to."""
         return read_center(self.meta, self.root / "transforms.json")
+
+    @property
+    def render_settings(self) -> RenderSettings | None:
+        """The render settings recorded in `nbv.render` (None when the writer recorded none)."""
+        return read_render_settings(self.meta, self.root / "transforms.json")
 
     def poses(self) -> np.ndarray:
         """(N, 4, 4) camera-to-world matrices, OpenCV convention."""
@@ -194,6 +202,7 @@ def read_dataset(path: str | Path) -> ViewDataset:
     nbv = object_field(doc, "nbv", doc_path)
     camera = read_camera(doc, nbv, doc_path)
     center = read_center(nbv, doc_path)
+    read_render_settings(nbv, doc_path)
     raw_frames = typed_field(doc, "frames", list, doc_path)
     if not raw_frames:
         raise DatasetError(f"{doc_path}: field frames is empty (a dataset needs at least one view)")

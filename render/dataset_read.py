@@ -21,7 +21,9 @@ import cv2
 import numpy as np
 from PIL import Image
 
+from common.provenance import config_from_record
 from render.camera import SENSOR_WIDTH_MM, UAVCamera
+from render.settings import RenderSettings
 from render.viewpoint import Viewpoint, opencv_to_opengl, validate_pose, viewpoint_to_c2w
 
 DEPTH_SCALE = 0.001
@@ -161,6 +163,22 @@ def read_camera(doc: dict, nbv: dict, where: Path) -> UAVCamera:
 def read_center(nbv: dict, where: Path) -> np.ndarray:
     """`nbv.center`: three finite coordinates (the origin when absent)."""
     return np.array(number_list(nbv.get("center", [0.0, 0.0, 0.0]), 3, where, "nbv.center", MAX_COORD_M))
+
+
+def read_render_settings(nbv: dict, where: Path) -> RenderSettings | None:
+    """`nbv.render`: the settings the views were rendered with, or None where none are recorded.
+
+    Fields an older writer did not know take their defaults (which reproduce its renders); an unknown
+    field, a bad value or a wrong type is refused, naming it."""
+    if "render" not in nbv:
+        return None
+    record = nbv["render"]
+    if not isinstance(record, dict):
+        raise DatasetError(f"{where}: field nbv.render must be an object, got {type(record).__name__}")
+    try:
+        return config_from_record(RenderSettings, record)
+    except (TypeError, ValueError) as err:
+        raise DatasetError(f"{where}: field nbv.render: {err}") from err
 
 
 def contained_file(root: Path, value: str, where: Path, name: str) -> Path:

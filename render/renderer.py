@@ -9,6 +9,14 @@ on the optical axis: z-depth exactly, with no near-plane offset to undo.
 
 Mitsuba's `look_at` camera frame is +Z forward, +Y up, +X towards image left;
 an OpenCV camera-to-world maps to it as `c2w @ diag(-1, -1, 1, 1)`.
+
+The RGB pass follows `RenderSettings`: pixel filter, integrator, spp, lighting
+(`render.lighting`), texture detail (`render.texture_scale`) and resolution
+(`RenderSettings.render_camera`: the lens is kept, so the field of view is).
+Its linear output goes through `render.postprocess` (denoise, exposure, noise,
+sRGB, JPEG); with the denoiser on, a third pass renders its albedo and normal
+guides at the RGB pass's spp, filter and seed. With motion blur, both are the
+mean over sub-frame poses (`render.motion_blur`); depth stays at the view's pose.
 """
 
 from __future__ import annotations
@@ -18,7 +26,11 @@ import math
 import numpy as np
 
 from render.camera import UAVCamera
-from render.settings import RenderSettings
+from render.lighting import scene_emitters
+from render.motion_blur import subframe_poses
+from render.postprocess import postprocess
+from render.settings import LightingSettings, RenderSettings
+from render.texture_scale import texture_dict
 from render.variant import select_variant
 from render.viewpoint import validate_pose
 from scenes.model import Material, Part, Scene
@@ -26,15 +38,10 @@ from scenes.model import Material, Part, Scene
 OPENCV_TO_MITSUBA = np.diag([-1.0, -1.0, 1.0, 1.0])
 
 
-def srgb_to_uint8(linear: np.ndarray) -> np.ndarray:
-    """Linear RGB in [0, 1] to 8-bit sRGB (the IEC 61966-2-1 transfer curve)."""
-    c = np.clip(linear, 0.0, 1.0)
-    srgb = np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
-    return np.round(srgb * 255.0).astype(np.uint8)
-
-
 class MitsubaRenderer:
     """Renders RGB (sRGB uint8) and z-depth (float32 metres) of one scene at any pose.
+
+    Images have the size of `self.camera`: the given camera at the settings' `resolution_scale`.
 
     Example:
         >>> from scenes import load_scene
@@ -48,13 +55,14 @@ class MitsubaRenderer:
         self.settings = settings or RenderSettings()
         self.mi = select_variant(variant or self.settings.variant)
         self.variant: str = self.mi.variant()
-        self.camera = camera
+        self.camera = self.settings.render_camera(camera)
         self.center = scene.center() if scene.parts else np.zeros(3)
         self._scene = self._load_scene(scene)
         self._rgb_integrator = self.mi.load_dict(
             {"type": self.settings.integrator, "max_depth": self.settings.max_depth}
             if self.settings.integrator == "path" else {"type": "direct"})
         self._depth_integrator = self.mi.load_dict({"type": "aov", "aovs": "dd.y:depth,p:position"})
+        self._guide_integrator = self.mi.load_dict({"type": "aov", "aovs": "albedo:albedo,nn:sh_normal"})
         self._views_rendered = 0
 
     def render(self, c2w: np.ndarray, seed: int | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -79,10 +87,27 @@ class MitsubaRenderer:
         if seed is None:
             seed = self.settings.view_seed(self._views_rendered)
         self._views_rendered += 1
-        sensor = self._sensor(pose, "gaussian", {"type": "independent"}, self.settings.spp)
-        image = self.mi.render(self._scene, sensor=sensor, integrator=self._rgb_integrator,
-                               spp=self.settings.spp, seed=int(seed))
-        return srgb_to_uint8(np.asarray(image)[..., :3])
+        poses = subframe_poses(pose, self.settings.motion_blur_m, self.settings.motion_blur_frames)
+        image = self._mean_pass(poses, int(seed), self._rgb_integrator)
+        albedo = normal = None
+        if self.settings.denoiser != "off":
+            guides = self._mean_pass(poses, int(seed), self._guide_integrator)
+            albedo, normal = guides[..., 0:3], guides[..., 3:6]
+        return postprocess(image[..., :3], self.settings, int(seed), albedo, normal)
+
+    def _mean_pass(self, poses: list[np.ndarray], seed: int, integrator) -> np.ndarray:
+        """One RGB-sensor pass of `integrator`: at one pose as rendered, over motion-blur sub-frames their
+        mean, sub-frame k seeded `seed * frames + k` with `spp // frames` samples (at least 1)."""
+        if len(poses) == 1:
+            spp, seeds = self.settings.spp, [seed]
+        else:
+            spp = max(1, self.settings.spp // len(poses))
+            seeds = [(seed * len(poses) + k) % 2**32 for k in range(len(poses))]
+        images = [np.asarray(self.mi.render(self._scene, integrator=integrator, spp=spp, seed=s,
+                                            sensor=self._sensor(p, self.settings.rgb_filter,
+                                                                {"type": "independent"}, spp)))
+                  for p, s in zip(poses, seeds)]
+        return images[0] if len(images) == 1 else np.mean(images, axis=0, dtype=np.float32)
 
     def _depth(self, pose: np.ndarray) -> np.ndarray:
         sampler = {"type": "stratified", "jitter": False}
@@ -111,21 +136,18 @@ class MitsubaRenderer:
     def _load_scene(self, scene: Scene):
         mi = self.mi
         if scene.mitsuba_xml is not None:
+            if self.settings.lighting != LightingSettings() or self.settings.texture_scale != 1.0:
+                raise ValueError(f"{scene.mitsuba_xml} is a Mitsuba XML scene, rendered as is: lighting "
+                                 "settings and texture_scale do not apply to it")
             return mi.load_file(str(scene.mitsuba_xml))
         bsdfs = {m.name: self._bsdf(m) for m in {p.material.name: p.material for p in scene.parts}.values()}
-        light = scene.lighting
-        items = {
-            "type": "scene",
-            "sun": {"type": "directional", "direction": light.sun_direction().tolist(),
-                    "irradiance": {"type": "rgb", "value": [light.sun_irradiance] * 3}},
-            "sky": {"type": "constant", "radiance": {"type": "rgb", "value": list(light.sky_radiance)}},
-        }
+        items = {"type": "scene", **scene_emitters(scene.lighting, self.settings.lighting)}
         for i, part in enumerate(scene.parts):
             items[f"part_{i:04d}"] = self._mesh(part, bsdfs[part.material.name])
         return mi.load_dict(items)
 
     def _bsdf(self, material: Material):
-        reflectance = ({"type": "bitmap", "filename": str(material.texture), "wrap_mode": "repeat"}
+        reflectance = (texture_dict(self.mi, material.texture, self.settings.texture_scale)
                        if material.texture is not None
                        else {"type": "rgb", "value": _srgb_to_linear(material.color)})
         if material.roughness is None:

@@ -10,6 +10,7 @@ _EXPORTS = {
     "Features": "nbv.features.sift",
     "extract_features": "nbv.features.sift",
     "dataset_features": "nbv.features.cache",
+    "repeatability": "nbv.features.repeatability",
 }
 __all__ = sorted(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

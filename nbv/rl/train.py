@@ -31,7 +31,7 @@ from torchrl.objectives import SACLoss
 from tqdm import tqdm
 
 from common.io import write_json
-from common.provenance import config_record
+from common.provenance import config_from_record, config_record
 from common.threads import set_torch_threads
 from nbv.rl.builders import (
     make_collector,
@@ -67,6 +67,15 @@ CSV_FIELDS = ("frames", "updates", "reward_mean", "episode_return", "episodes", 
               "entropy", "alpha", "collect_s", "update_s")
 
 
+def with_defaults(saved: dict) -> dict:
+    """A recorded run config with the settings added since it was written at their defaults (which
+    reproduce the older behaviour, e.g. render settings); as recorded where it does not parse."""
+    try:
+        return config_record(config_from_record(TrainConfig, saved))
+    except (TypeError, ValueError):
+        return saved
+
+
 def train(config: TrainConfig) -> Path:
     """Train (or resume training) into `config.logger.out`; return the checkpoint path.
 
@@ -76,7 +85,7 @@ def train(config: TrainConfig) -> Path:
     ckpt_path = run / CHECKPOINT
     resumed = load_checkpoint(ckpt_path) if ckpt_path.exists() else None
     if resumed is not None:
-        saved = checkpoint_config(resumed, ckpt_path)
+        saved = with_defaults(checkpoint_config(resumed, ckpt_path))
         check_compatible(ckpt_path, saved, config_record(config), RESUMABLE_CHANGES)
     write_json(run / "config.json", config_record(config))
     seed = config.collector.seed

@@ -14,9 +14,14 @@ def test_help_builds_and_exits_0(name, capsys):
 
 
 @pytest.mark.parametrize("name, flags", [
-    ("scan", ["--width", "--spp", "--up-axis", "--seed", "--variant"]),
-    ("plan", ["--planner", "--views", "--match-cosine", "--up-axis", "--focal-mm", "--metric-points"]),
-    ("train", ["--scene", "--frames", "--bov-ranges", "--feature-backend", "--match-cosine", "--up-axis"]),
+    ("scan", ["--width", "--spp", "--up-axis", "--seed", "--variant", "--denoiser", "--pixel-filter",
+              "--resolution-scale", "--texture-scale", "--motion-blur-m", "--motion-blur-frames",
+              "--sky-model", "--light-mode", "--sun-elevation-deg", "--sun-azimuth-deg", "--turbidity",
+              "--exposure-stops", "--shot-noise", "--read-noise", "--jpeg-quality"]),
+    ("plan", ["--planner", "--views", "--match-cosine", "--up-axis", "--focal-mm", "--metric-points",
+              "--denoiser", "--jpeg-quality", "--sky-model"]),
+    ("train", ["--scene", "--frames", "--bov-ranges", "--feature-backend", "--match-cosine", "--up-axis",
+               "--denoiser", "--jpeg-quality", "--light-mode"]),
     ("demo", ["--width", "--ranges", "--words", "--up-axis", "--voxel-size-m", "--metric-points"]),
     ("tables", ["--scenes", "--ranges", "--words", "--up-axis", "--match-cosine"]),
     ("refine", ["--ranges", "--words", "--features", "--match-cosine", "--memory-cap"]),

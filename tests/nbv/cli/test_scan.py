@@ -1,5 +1,6 @@
 """`nbv scan`, `nbv scene` and `nbv demo` run end to end; bad input exits 2 naming the fault."""
 
+import json
 
 import pytest
 
@@ -17,6 +18,27 @@ def test_scan_circle_writes_a_readable_dataset(tmp_path):
     assert [round(f.viewpoint.elevation, 6) for f in ds.frames] == [round(0.349066, 6)] * 4
 
 
+def test_scan_takes_every_render_setting_as_a_flag_and_records_it(tmp_path):
+    out = tmp_path / "ds"
+    assert main(["scan", "test_building", "--plan", "circle", "--views", "2", "--width", "32",
+                 "--height", "24", "--spp", "2", "--pixel-filter", "tent", "--resolution-scale", "1.5",
+                 "--texture-scale", "0.5", "--motion-blur-m", "0.02", "--motion-blur-frames", "2",
+                 "--sky-model", "sunsky", "--light-mode", "overcast", "--sun-elevation-deg", "30",
+                 "--sun-azimuth-deg", "100", "--turbidity", "4", "--exposure-stops", "0.5",
+                 "--shot-noise", "0.001", "--read-noise", "0.002", "--jpeg-quality", "70",
+                 "--out", str(out)]) == 0
+    doc = json.loads((out / "transforms.json").read_text())
+    assert (doc["w"], doc["h"]) == (48, 36)
+    render = doc["nbv"]["render"]
+    assert (render["pixel_filter"], render["resolution_scale"], render["texture_scale"]) == ("tent", 1.5, 0.5)
+    assert (render["motion_blur_m"], render["motion_blur_frames"]) == (0.02, 2)
+    assert render["lighting"] == {"sky_model": "sunsky", "light_mode": "overcast", "sun_elevation_deg": 30.0,
+                                  "sun_azimuth_deg": 100.0, "turbidity": 4.0}
+    assert render["sensor"] == {"exposure_stops": 0.5, "shot_noise": 0.001, "read_noise": 0.002,
+                                "jpeg_quality": 70}
+    assert read_dataset(out).render_settings.sensor.jpeg_quality == 70
+
+
 def test_scene_list_and_export(tmp_path, capsys):
     assert main(["scene", "list"]) == 0
     assert "test_building" in capsys.readouterr().out.split()
@@ -29,6 +51,14 @@ def test_scene_list_and_export(tmp_path, capsys):
     (["test_building", "--width", "0"], "width"),
     (["test_building", "--focal-mm", "-3"], "focal_mm"),
     (["test_building", "--plan", "circle", "--views", "0"], "views"),
+    (["test_building", "--jpeg-quality", "0"], "jpeg_quality must be in 1..100, got 0"),
+    (["test_building", "--resolution-scale", "0"], "resolution_scale"),
+    (["test_building", "--texture-scale", "2"], "texture_scale"),
+    (["test_building", "--motion-blur-frames", "1"], "motion_blur_frames"),
+    (["test_building", "--sun-elevation-deg", "-5"], "sun_elevation_deg"),
+    (["test_building", "--turbidity", "20"], "turbidity"),
+    (["test_building", "--shot-noise", "nan"], "shot_noise"),
+    (["test_building", "--exposure-stops", "inf"], "exposure_stops"),
 ])
 def test_bad_scan_input_exits_2_with_a_message(tmp_path, capsys, args, message):
     assert main(["scan", *args, "--out", str(tmp_path / "ds")]) == 2

@@ -157,10 +157,11 @@ def test_bare_policy_spec_is_the_shipped_policy():
 def test_shipped_policy_is_the_default_training_command_and_plans():
     from common.provenance import config_record
     from nbv.cli.train import parse_train
+    from nbv.rl.train import with_defaults
 
     raw = torch.load(SHIPPED_POLICY, weights_only=True)  # no pickled code in the shipped file
     assert raw["format"] == "nbv-sac-policy" and SHIPPED_POLICY.stat().st_size < 5_000_000
-    shipped = json.loads(raw["config"])
+    shipped = with_defaults(json.loads(raw["config"]))  # settings added since then at their defaults
     default = config_record(parse_train(["--out", "runs/default"]))
     for group in ("env", "collector", "replay_buffer", "optim", "network"):
         assert shipped[group] == default[group], group  # `nbv train --out runs/default` retrains it

@@ -18,7 +18,7 @@ from nbv.rl.config import EnvConfig
 from nbv.rl.env import NBVEnv, action_to_viewpoint, check_action, wrap_angle
 from render.camera import UAVCamera
 from render.renderer import MitsubaRenderer
-from render.settings import RenderSettings
+from render.settings import LightingSettings, RenderSettings, SensorSettings
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes import load_scene
 from scenes.spec import SceneSet
@@ -46,6 +46,19 @@ def test_specs_parallel_env_two_workers():
         assert rollout["next", "pixels"].shape == (2, 2, 5, 32, 32)
     finally:
         env.close()
+
+
+def test_env_renders_with_every_render_setting():
+    render = RenderSettings(spp=1, resolution_scale=0.5, lighting=LightingSettings(light_mode="overcast"),
+                            sensor=SensorSettings(exposure_stops=1.0, shot_noise=0.01, jpeg_quality=40))
+    env = NBVEnv(tiny_config(render=render), seed=3)
+    env.reset()  # renders view 0
+    image = env.render_view(env.viewpoint)
+    seeded = replace(render, seed=3)
+    renderer = MitsubaRenderer(load_scene("test_building"), UAVCamera(64, 48), seeded)
+    expected = renderer.render_rgb(viewpoint_to_c2w(env.viewpoint, renderer.center), seed=seeded.view_seed(1))
+    assert image.shape == (24, 32, 3)
+    np.testing.assert_array_equal(image, expected)
 
 
 def test_observation_histories():

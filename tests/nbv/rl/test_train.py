@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import json
 import math
 from dataclasses import replace
 
@@ -14,7 +15,7 @@ from tensordict import TensorDict
 from nbv.bov.config import BoVConfig
 from nbv.cli import main
 from nbv.rl.builders import make_loss_module, make_optimizers, make_sac_agent
-from nbv.rl.checkpoint import CheckpointError, load_checkpoint
+from nbv.rl.checkpoint import CheckpointError, load_checkpoint, save_checkpoint
 from nbv.rl.config import CollectorConfig, EnvConfig, LoggerConfig, OptimConfig, TrainConfig
 from nbv.rl.train import sac_update, train
 from render.camera import UAVCamera
@@ -119,6 +120,18 @@ def test_resuming_with_other_settings_is_refused(tmp_path):
     other_bov = replace(config, env=replace(config.env, bov=replace(config.env.bov, match_cosine=0.6)))
     with pytest.raises(CheckpointError, match="env.bov.match_cosine: checkpoint 0.8, now 0.6"):
         train(other_bov)
+
+
+def test_a_checkpoint_from_before_the_render_settings_resumes(tmp_path):
+    train(tiny(tmp_path / "run", 2))
+    path = tmp_path / "run" / "checkpoint.pt"
+    state = load_checkpoint(path)
+    config = json.loads(state["config"])
+    config["env"]["render"] = {key: config["env"]["render"][key]
+                               for key in ("spp", "max_depth", "integrator", "variant", "seed")}
+    save_checkpoint(path, {**state, "config": json.dumps(config)})
+    train(tiny(tmp_path / "run", 4))
+    assert load_checkpoint(path)["counters"]["frames"] == 4
 
 
 def test_corrupt_checkpoint_in_run_folder_is_a_clear_cli_error(tmp_path, capsys):

@@ -1,4 +1,5 @@
-"""`nbv plan SCENE --planner {policy[-sample]:CKPT,random,circle,greedy,hemisphere} [--views N] --out DIR`."""
+"""`nbv plan SCENE --planner {policy[-sample]:CKPT,random,circle,greedy,hemisphere,infogain,oracle}
+[--views N] --out DIR`."""
 
 from __future__ import annotations
 

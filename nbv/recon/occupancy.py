@@ -1,10 +1,10 @@
 """A ternary occupancy grid (unknown / free / occupied) built from depth images, and its view gain.
 
 The volumetric map of active reconstruction (Isler et al., "An Information Gain
-Formulation for Active Volumetric 3D Reconstruction", ICRA 2016, Sec. III;
-Delmerico et al., "A comparison of volumetric information gain metrics for
-active 3D object reconstruction", Autonomous Robots 42, 2018, Sec. 3), kept
-ternary instead of probabilistic:
+Formulation for Active Volumetric 3D Reconstruction", ICRA 2016; Delmerico et
+al., "A comparison of volumetric information gain metrics for active 3D object
+reconstruction", Autonomous Robots 42, 2018), kept ternary instead of
+probabilistic:
 
 - `integrate`: every voxel a captured pixel's ray crosses before its hit becomes
   free; the voxel holding the hit becomes occupied. A pixel with depth 0 (no

@@ -15,7 +15,8 @@ def test_help_builds_and_exits_0(name, capsys):
 
 @pytest.mark.parametrize("name, flags", [
     ("scan", ["--width", "--spp", "--up-axis", "--seed", "--variant"]),
-    ("plan", ["--planner", "--views", "--match-cosine", "--up-axis", "--focal-mm", "--metric-points"]),
+    ("plan", ["--planner", "--views", "--match-cosine", "--up-axis", "--focal-mm", "--metric-points",
+              "infogain", "oracle", "--candidates", "--grid-resolution", "--gain-ray-stride"]),
     ("train", ["--scene", "--frames", "--bov-ranges", "--feature-backend", "--match-cosine", "--up-axis"]),
     ("demo", ["--width", "--ranges", "--words", "--up-axis", "--voxel-size-m", "--metric-points"]),
     ("tables", ["--scenes", "--ranges", "--words", "--up-axis", "--match-cosine"]),

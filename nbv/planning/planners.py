@@ -16,8 +16,9 @@ interface and the candidate scheme of the greedy planners are in `base.py`.
 - `InfoGainPlanner` (`infogain.py`): greedy on volumetric information gain,
   the unknown voxels a candidate would see in an occupancy grid built from the
   depth of the views flown to (model-free, geometric, no appearance).
-- `CoverageOraclePlanner` (`oracle.py`): greedy on the true surface among the
-  same candidates; it uses the ground-truth mesh, so it is an upper-bound
+- `CoverageOraclePlanner` (`oracle.py`): the views that see the most of the
+  true surface among greedy's candidates and a fixed lattice (greedy with
+  restarts, then swaps); it uses the ground-truth mesh, so it is an upper-bound
   reference, not a planner a real UAV could run.
 - `PolicyPlanner`: a trained SAC actor from the env's start view, acting on
   its distribution's mode (`policy:CHECKPOINT`, deterministic) or on seeded

@@ -1,4 +1,5 @@
-"""`nbv plan SCENE --planner {policy[-sample]:CKPT,random,circle,greedy,hemisphere} [--views N] --out DIR`."""
+"""`nbv plan SCENE --planner {policy[-sample]:CKPT,random,circle,greedy,hemisphere,infogain,oracle}
+[--views N] --out DIR`."""
 
 from __future__ import annotations
 
@@ -10,7 +11,8 @@ from nbv.planning.plan import PlanConfig, plan_scan
 
 
 def main(args: Sequence[str], prog: str) -> int:
-    """Parse `PlanConfig`; plan, capture, reconstruct and score; print the metrics."""
+    """Parse `PlanConfig`; plan, capture, reconstruct and score; print the metrics (no `reference` with
+    --no-full-scan)."""
     doc = plan_scan(parse(PlanConfig, args, prog))
-    print(json.dumps({k: doc[k] for k in ("planner", "views", "gt", "reference")}, indent=2))
+    print(json.dumps({k: doc[k] for k in ("planner", "views", "gt", "reference") if k in doc}, indent=2))
     return 0

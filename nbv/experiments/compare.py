@@ -39,7 +39,7 @@ class CompareConfig(PlanSettings):
 
     planners: tuple[str, ...] = ("random", "circle", "greedy")
     """Planners to compare: policy:CHECKPOINT, policy-sample:CHECKPOINT, random, circle, greedy,
-    hemisphere."""
+    hemisphere, infogain, oracle (an upper bound: it uses the true mesh)."""
     seeds: tuple[int, ...] = (0, 1, 2)
     """Seeds per planner."""
     out: Path

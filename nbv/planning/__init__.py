@@ -8,6 +8,8 @@ from common.lazy import lazy_exports
 _EXPORTS = {
     "Planner": "nbv.planning.planners",
     "make_planner": "nbv.planning.planners",
+    "InfoGainPlanner": "nbv.planning.infogain",
+    "CoverageOraclePlanner": "nbv.planning.oracle",
     "PlanConfig": "nbv.planning.plan",
     "plan_scan": "nbv.planning.plan",
 }

@@ -26,7 +26,7 @@ from common.provenance import config_record
 from common.threads import chosen_threads, limit_torch_threads, worker_threads
 from nbv.bov.config import BoVConfig
 from nbv.planning.planners import Planner, PolicyPlanner, make_planner
-from nbv.recon.config import MetricsConfig, ReconstructionConfig
+from nbv.recon.config import MetricsConfig, OccupancyConfig, ReconstructionConfig
 from nbv.recon.evaluate import EvaluateConfig, GroundTruth, write_evaluation
 from nbv.recon.metrics import load_geometry
 from nbv.recon.tsdf import reconstruct_dataset, save_reconstruction
@@ -62,7 +62,9 @@ class PlanSettings:
     bov: BoVConfig = BoVConfig(ranges=8)
     """The Bag of Views of the greedy planner's reward (a policy keeps its training one)."""
     candidates: int = 8
-    """Greedy planner: candidate viewpoints rendered per step."""
+    """Greedy, oracle and infogain planners: candidate viewpoints per step (only greedy renders them)."""
+    occupancy: OccupancyConfig = OccupancyConfig()
+    """The infogain planner's occupancy grid."""
     reference: Path | None = None
     """Reference mesh (full-scan reconstruction); default: reconstruct the hemisphere scan, cached."""
     full_scan: bool = True
@@ -88,8 +90,9 @@ class PlanConfig(PlanSettings):
     """Settings of `nbv plan`."""
 
     planner: str = "random"
-    """random, circle, greedy, hemisphere, policy:CHECKPOINT (a `nbv train` checkpoint.pt, its mode) or
-    policy-sample:CHECKPOINT (seeded draws from the policy)."""
+    """random, circle, greedy, hemisphere, infogain (volumetric information gain, from depth), oracle (greedy
+    on the true surface: an upper bound, it uses the model), policy:CHECKPOINT (a `nbv train` checkpoint.pt,
+    its mode) or policy-sample:CHECKPOINT (seeded draws from the policy)."""
     out: Path
     """Output folder: views/, mesh.ply, points.ply, gt.ply, metrics.json, heatmap.*, trajectory.png,
     plan.json."""
@@ -122,8 +125,9 @@ def choose_views(config: PlanConfig, planner: Planner,
                  env_config: EnvConfig) -> tuple[list[Viewpoint], float, float]:
     """The planner's viewpoints, the planning wall time in seconds (renders included) and the part of it
     spent simulating the camera: loading the scene into the renderer, and rendering the views flown to
-    (the mean render time of a view times their count), images a real camera captures anyway. Greedy's
-    other candidate renders stay planning time.
+    (per kind of image, RGB or depth, the mean render time times their count, or times the images
+    rendered if fewer), images a real camera captures anyway. Greedy's other candidate renders stay
+    planning time.
 
     Torch runs on the thread policy's count (`common.threads.worker_threads`, 1) while planning, unless
     this process already chose its threads; the previous count is restored afterwards.
@@ -134,8 +138,15 @@ def choose_views(config: PlanConfig, planner: Planner,
         start = time.perf_counter()
         views = planner.plan(env, config.views)
         seconds = time.perf_counter() - start
-    rendered = env.render_seconds / max(env.views_rendered, 1) * len(views) if env.views_rendered else 0.0
-    return views, seconds, min(env.setup_seconds + rendered, seconds)
+    camera = (env.setup_seconds + flown_seconds(env.render_seconds, env.views_rendered, len(views))
+              + flown_seconds(env.depth_seconds, env.depths_rendered, len(views)))
+    return views, seconds, min(camera, seconds)
+
+
+def flown_seconds(seconds: float, rendered: int, flown: int) -> float:
+    """The share of `seconds` spent on `rendered` images that belongs to the views flown to: the mean per
+    image times `flown`, at most times `rendered` (a planner may render fewer images than it flies to)."""
+    return seconds / rendered * min(rendered, flown) if rendered else 0.0
 
 
 def reference_mesh(config: PlanConfig, scene: Scene | None = None) -> Path:
@@ -173,7 +184,7 @@ def plan_scan(config: PlanConfig) -> dict:
     """
     out = Path(config.out)
     check_output_folder(out, config.overwrite)
-    planner = make_planner(config.planner, config.seed, config.candidates)
+    planner = make_planner(config.planner, config.seed, config.candidates, config.occupancy)
     views, plan_s, camera_s = choose_views(config, planner, planning_env_config(config, planner))
     scene = config.scene.load()
     settings = replace(config.render, seed=config.seed)

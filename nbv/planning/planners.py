@@ -3,7 +3,8 @@
 `Planner.plan(env, views)` returns the viewpoints to capture, in order. The
 env (a one-worker `NBVEnv` on the target scene) supplies the allowed ranges,
 the start viewpoint, rendering, features and the Bag of Views; the planners
-that need no images (random, circle, hemisphere) use only its config.
+that need no images (random, circle, hemisphere) use only its config. The
+interface and the candidate scheme of the greedy planners are in `base.py`.
 
 - `RandomPlanner`: viewpoints drawn uniformly in the allowed ranges.
 - `CirclePlanner`: evenly spaced azimuths at the middle radius and elevation.
@@ -12,6 +13,13 @@ that need no images (random, circle, hemisphere) use only its config.
   highest Bag of Views reward (Sec. IV's reward under the env's `bov` config, no learning).
 - `HemispherePlanner`: the full-coverage hemisphere scan (Sec. V-B), the
   paper's reference.
+- `InfoGainPlanner` (`infogain.py`): greedy on volumetric information gain,
+  the unknown voxels a candidate would see in an occupancy grid built from the
+  depth of the views flown to (model-free, geometric, no appearance).
+- `CoverageOraclePlanner` (`oracle.py`): the views that see the most of the
+  true surface among greedy's candidates and a fixed lattice (greedy with
+  restarts, then swaps); it uses the ground-truth mesh, so it is an upper-bound
+  reference, not a planner a real UAV could run.
 - `PolicyPlanner`: a trained SAC actor from the env's start view, acting on
   its distribution's mode (`policy:CHECKPOINT`, deterministic) or on seeded
   draws from it (`policy-sample:CHECKPOINT`, the max-entropy policy SAC
@@ -22,7 +30,6 @@ from __future__ import annotations
 
 import copy
 import math
-from abc import ABC, abstractmethod
 from pathlib import Path
 
 import numpy as np
@@ -30,34 +37,16 @@ import torch
 from torchrl.envs.utils import ExplorationType, set_exploration_type
 
 from common.provenance import config_from_record
+from nbv.planning.base import Planner, check_candidates, sample_viewpoints
+from nbv.planning.infogain import InfoGainPlanner
+from nbv.planning.oracle import CoverageOraclePlanner
+from nbv.recon.config import OccupancyConfig
 from nbv.rl.agent import make_actor
 from nbv.rl.checkpoint import CheckpointError, load_policy
 from nbv.rl.config import EnvConfig, NetworkConfig
 from nbv.rl.env import NBVEnv
 from render.scan import HemispherePlan, hemisphere_scan
 from render.viewpoint import TWO_PI, Viewpoint
-
-
-class Planner(ABC):
-    """Chooses the viewpoints of one scan."""
-
-    name: str = ""
-    """Short name used on the command line and in tables."""
-
-    @abstractmethod
-    def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
-        """The viewpoints to capture, in order.
-
-        Args:
-            env: a one-worker env on the target scene, freshly seeded.
-            views: how many viewpoints; None for the planner's own count.
-        """
-
-
-def sample_viewpoints(config: EnvConfig, count: int, rng: np.random.Generator) -> list[Viewpoint]:
-    """`count` viewpoints drawn uniformly in the config's ranges of R, azimuth and elevation."""
-    low, high = config.low, config.high
-    return [Viewpoint(*map(float, low + rng.random(3) * (high - low))) for _ in range(count)]
 
 
 class RandomPlanner(Planner):
@@ -109,9 +98,8 @@ class GreedyBoVPlanner(Planner):
     name = "greedy"
 
     def __init__(self, candidates: int = 8, seed: int = 0, default_views: int = 13) -> None:
-        if candidates < 1:
-            raise ValueError(f"greedy planner needs at least 1 candidate, got {candidates}")
-        self.candidates, self.seed, self.default_views = candidates, seed, default_views
+        self.candidates = check_candidates("greedy", candidates)
+        self.seed, self.default_views = seed, default_views
 
     def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
         """The start view, then `views - 1` greedy moves (default 13 views in all)."""
@@ -193,9 +181,12 @@ def split_policy_spec(spec: str) -> tuple[str, str] | None:
     return kind, checkpoint if sep else str(SHIPPED_POLICY)
 
 
-def make_planner(spec: str, seed: int = 0, candidates: int = 8) -> Planner:
-    """A planner by name: random, circle, greedy, hemisphere, policy[:CHECKPOINT], policy-sample[:CHECKPOINT]
-    (a training checkpoint.pt or a policy.pt; without one, the shipped policy)."""
+def make_planner(spec: str, seed: int = 0, candidates: int = 8,
+                 occupancy: OccupancyConfig = OccupancyConfig()) -> Planner:
+    """A planner by name: random, circle, greedy, hemisphere, infogain, oracle, policy[:CHECKPOINT],
+    policy-sample[:CHECKPOINT] (a training checkpoint.pt or a policy.pt; without one, the shipped policy).
+
+    `candidates` is K of greedy, infogain and oracle; `occupancy` is infogain's grid."""
     if policy := split_policy_spec(spec):
         kind, checkpoint = policy
         return PolicyPlanner(checkpoint, sample=kind == "policy-sample", seed=seed)
@@ -207,8 +198,12 @@ def make_planner(spec: str, seed: int = 0, candidates: int = 8) -> Planner:
         return GreedyBoVPlanner(candidates, seed)
     if spec == "hemisphere":
         return HemispherePlanner()
-    raise ValueError(f"unknown planner {spec!r}; use random, circle, greedy, hemisphere, policy:CHECKPOINT "
-                     "or policy-sample:CHECKPOINT")
+    if spec == "infogain":
+        return InfoGainPlanner(candidates, seed, occupancy)
+    if spec == "oracle":
+        return CoverageOraclePlanner(candidates, seed)
+    raise ValueError(f"unknown planner {spec!r}; use random, circle, greedy, hemisphere, infogain, oracle, "
+                     "policy:CHECKPOINT or policy-sample:CHECKPOINT")
 
 
 def planner_label(spec: str) -> str:

@@ -107,3 +107,27 @@ class HeatmapConfig:
             raise ValueError(f"heat map max_cm must be positive, got {self.max_cm}")
         if not self.views:
             raise ValueError("heat map needs at least one view")
+
+
+@dataclass(frozen=True)
+class OccupancyConfig:
+    """The information-gain planner's occupancy grid over the target's bounds (`nbv.recon.occupancy`)."""
+
+    grid_resolution: int = 64
+    """Voxels along the longest side of the padded target bounds (cubic voxels; 64: about 1.7 cm)."""
+    grid_margin_m: float = 0.05
+    """Padding of the target's bounding box on its four sides and its top, metres (the base stays on the
+    ground, z = 0)."""
+    gain_ray_stride: int = 4
+    """A candidate's gain casts a ray through every n-th pixel along both image axes (4: 80 x 60 rays at
+    320 x 240)."""
+    integrate_ray_stride: int = 2
+    """A captured depth image carves free space along every n-th pixel's ray along both axes (every
+    pixel's hit is marked occupied)."""
+
+    def __post_init__(self) -> None:
+        for name in ("grid_resolution", "gain_ray_stride", "integrate_ray_stride"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"occupancy {name} must be >= 1, got {getattr(self, name)}")
+        if not math.isfinite(self.grid_margin_m) or self.grid_margin_m < 0:
+            raise ValueError(f"occupancy grid_margin_m must be >= 0, got {self.grid_margin_m!r}")

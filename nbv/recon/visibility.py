@@ -6,7 +6,8 @@ by a view when it projects inside the image in front of the camera and no surfac
 lies before it on its pixel's ray (its z-depth is within `tolerance_m` of the
 ray-cast depth there). Used to score planners cheaply where the TSDF pipeline
 would cost minutes (choosing `nbv train`'s defaults on validation buildings,
-`scripts/select_defaults.py`); reported figures use the fused reconstruction
+`scripts/select_defaults.py`), and the objective of the coverage oracle planner
+(`nbv.planning.oracle`); reported figures use the fused reconstruction
 (`nbv.recon.evaluate`).
 
 Example: a unit cube seen from +x shows one face of six.
@@ -29,6 +30,7 @@ import trimesh
 
 from render.camera import UAVCamera
 from render.raycast import DepthRaycaster
+from scenes.model import Scene
 
 
 def seen_mask(points: np.ndarray, depth: np.ndarray, K: np.ndarray, c2w: np.ndarray,  # noqa: N803
@@ -47,22 +49,45 @@ def seen_mask(points: np.ndarray, depth: np.ndarray, K: np.ndarray, c2w: np.ndar
     return inside & (hit > 0) & (z <= hit + tolerance_m)
 
 
+class SurfaceVisibility:
+    """Seeded samples of a target surface, and which of them a camera pose sees past the occluders.
+
+    Args:
+        occluders: every mesh that can hide the target (the target's own parts included).
+        target: the surface whose samples are tested.
+        camera: intrinsics and resolution of the views.
+        points: surface samples (area-uniform, seeded).
+        tolerance_m: depth slack of the occlusion test, metres.
+        seed: seed of the sampling.
+    """
+
+    def __init__(self, occluders: Sequence[trimesh.Trimesh], target: trimesh.Trimesh, camera: UAVCamera,
+                 points: int = 20_000, tolerance_m: float = 0.02, seed: int = 0) -> None:
+        self.samples = np.asarray(trimesh.sample.sample_surface(target, points, seed=seed)[0])
+        self.caster = DepthRaycaster(occluders, camera.K, camera.width, camera.height)
+        self.K, self.tolerance_m = camera.K, tolerance_m
+
+    def seen(self, c2w: np.ndarray) -> np.ndarray:
+        """(points,) True where a sample is seen from the OpenCV camera-to-world `c2w`."""
+        return seen_mask(self.samples, self.caster.depth(c2w), self.K, c2w, self.tolerance_m)
+
+
+def scene_visibility(scene: Scene, camera: UAVCamera, points: int = 20_000, tolerance_m: float = 0.02,
+                     seed: int = 0) -> SurfaceVisibility:
+    """`SurfaceVisibility` of a scene's target mesh, hidden by all its parts (the ground included)."""
+    occluders = [trimesh.Trimesh(p.vertices, p.faces, process=False) for p in scene.parts]
+    return SurfaceVisibility(occluders, scene.target_mesh(), camera, points, tolerance_m, seed)
+
+
 def visible_coverage(occluders: Sequence[trimesh.Trimesh], target: trimesh.Trimesh, camera: UAVCamera,
                      poses: Sequence[np.ndarray], points: int = 20_000, tolerance_m: float = 0.02,
                      seed: int = 0) -> float:
     """The share of `points` samples of the target surface seen by at least one OpenCV c2w pose.
 
-    Args:
-        occluders: every mesh that can hide the target (the target's own parts included).
-        target: the surface whose coverage is measured.
-        camera: intrinsics and resolution of the views.
-        poses: camera-to-world matrices.
-        points: surface samples (area-uniform, seeded).
-        tolerance_m: depth slack of the occlusion test, metres.
+    Arguments as `SurfaceVisibility`'s; `poses` are camera-to-world matrices.
     """
-    samples, _ = trimesh.sample.sample_surface(target, points, seed=seed)
-    caster = DepthRaycaster(occluders, camera.K, camera.width, camera.height)
-    seen = np.zeros(len(samples), dtype=bool)
+    visibility = SurfaceVisibility(occluders, target, camera, points, tolerance_m, seed)
+    seen = np.zeros(len(visibility.samples), dtype=bool)
     for pose in poses:
-        seen |= seen_mask(samples, caster.depth(pose), camera.K, pose, tolerance_m)
+        seen |= visibility.seen(pose)
     return float(seen.mean())

@@ -32,7 +32,9 @@ Rendering: one renderer per scene (loaded with the scene set's up axis),
 created lazily on the first reset, in the process that steps the env, so
 `ParallelEnv`'s spawned workers each choose their own Mitsuba variant; view k
 is rendered with the config's render settings' `view_seed(k)` under the env's
-seed. The constructor takes only picklable settings. Before the first view is
+seed. `render_depth` gives the z-depth a depth camera returns at a view
+(the information-gain planner's input), timed apart from the RGB renders.
+The constructor takes only picklable settings. Before the first view is
 rendered the process's torch threads follow the thread policy
 (`common.threads.apply_thread_policy`: 1 unless the process chose otherwise),
 since the renderer and Kornia SIFT share the cores with everything else.
@@ -159,6 +161,8 @@ class NBVEnv(EnvBase):
         self._episode = 0
         self._views_rendered = 0
         self.render_seconds = 0.0  # wall time of those renders (planning time without renders)
+        self._depths_rendered = 0
+        self.depth_seconds = 0.0  # wall time of the depth images rendered (`render_depth`)
         self.setup_seconds = 0.0  # wall time loading scenes into renderers (camera setup)
         self._bov = None
 
@@ -213,6 +217,18 @@ class NBVEnv(EnvBase):
         return self._views_rendered
 
     @property
+    def depths_rendered(self) -> int:
+        """Depth images rendered since the seed was set (`depth_seconds` is their wall time)."""
+        return self._depths_rendered
+
+    @property
+    def scene(self) -> Scene:
+        """The current scene, loaded (after the first reset)."""
+        if self._view is None:
+            raise RuntimeError("NBVEnv.scene needs an episode: call reset() first")
+        return self._load(self._scene)
+
+    @property
     def viewpoint(self) -> Viewpoint | None:
         """The current camera viewpoint (None before the first reset)."""
         return self._view
@@ -252,6 +268,16 @@ class NBVEnv(EnvBase):
         rgb = renderer.render_rgb(viewpoint_to_c2w(view, renderer.center), seed=seed)
         self.render_seconds += time.perf_counter() - start
         return rgb
+
+    def render_depth(self, view: Viewpoint) -> np.ndarray:
+        """The z-depth image at `view` of the current scene (H x W float32 metres, 0 for no hit): what a
+        depth camera returns there. Always rendered, lattice or not."""
+        renderer = self._renderer(self._scene)
+        start = time.perf_counter()
+        depth = renderer.render_depth(viewpoint_to_c2w(view, renderer.center))
+        self.depth_seconds += time.perf_counter() - start
+        self._depths_rendered += 1
+        return depth
 
     def snap(self, view: Viewpoint) -> Viewpoint:
         """`view` itself, or with a lattice (training) the nearest lattice node of the current scene."""

@@ -19,6 +19,7 @@ def test_help_builds_and_exits_0(name, capsys):
               "--sky-model", "--light-mode", "--sun-elevation-deg", "--sun-azimuth-deg", "--turbidity",
               "--exposure-stops", "--shot-noise", "--read-noise", "--jpeg-quality"]),
     ("plan", ["--planner", "--views", "--match-cosine", "--up-axis", "--focal-mm", "--metric-points",
+              "infogain", "oracle", "--candidates", "--grid-resolution", "--gain-ray-stride",
               "--denoiser", "--jpeg-quality", "--sky-model"]),
     ("train", ["--scene", "--frames", "--bov-ranges", "--feature-backend", "--match-cosine", "--up-axis",
                "--denoiser", "--jpeg-quality", "--light-mode"]),

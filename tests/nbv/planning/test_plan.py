@@ -43,6 +43,24 @@ def test_nbv_plan_end_to_end(tmp_path, capsys):
     assert main(args) == 2  # refuses to overwrite without --overwrite
 
 
+@pytest.mark.parametrize("planner", ["oracle", "infogain"])
+def test_nbv_plan_with_the_oracle_and_information_gain(planner, tmp_path, capsys):
+    reference = tmp_path / "reference.ply"
+    load_scene("test_building").target_mesh().export(reference)
+    out = tmp_path / planner
+    scoring = ["--reference", str(reference)] if planner == "oracle" else ["--no-full-scan"]  # gt only
+    args = ["plan", "test_building", "--planner", planner, "--views", "3", "--candidates", "2",
+            "--width", "64", "--height", "48", "--spp", "1", *scoring, "--metric-points", "3000",
+            "--voxel-size-m", "0.01", "--grid-resolution", "16", "--out", str(out)]
+    assert main(args) == 0
+    plan = json.loads((out / "plan.json").read_text())
+    assert ("reference" in plan) == (planner == "oracle")
+    assert plan["planner"] == planner and plan["views"] == 3 and len(read_dataset(out / "views")) == 3
+    assert 0.0 < plan["gt"]["coverage"] <= 1.0 and 0.0 <= plan["deciding_s"] <= plan["planning_s"]
+    assert plan["config"]["candidates"] == 2 and plan["config"]["occupancy"]["grid_resolution"] == 16
+    assert f'"planner": "{planner}"' in capsys.readouterr().out
+
+
 def test_nbv_plan_unknown_planner_is_a_clear_error(tmp_path, capsys):
     assert main(["plan", "test_building", "--planner", "best", "--out", str(tmp_path / "p")]) == 2
     assert "unknown planner" in capsys.readouterr().err
@@ -93,6 +111,14 @@ def test_choose_views_plans_on_the_thread_policy_and_restores_torch(tmp_path, mo
         assert seen == [threads.worker_threads(), 2] and torch.get_num_threads() == 2
     finally:
         torch.set_num_threads(before)
+
+
+def test_the_camera_time_of_the_views_flown_to():
+    from nbv.planning.plan import flown_seconds
+
+    assert flown_seconds(10.0, 5, 2) == pytest.approx(4.0)  # greedy: 2 of 5 renders were flown to
+    assert flown_seconds(3.0, 1, 13) == pytest.approx(3.0)  # infogain: one RGB render for 13 views
+    assert flown_seconds(0.0, 0, 13) == 0.0  # random: nothing rendered
 
 
 def test_choose_views_counts_the_simulated_camera_apart_from_deciding(tmp_path):

@@ -1,0 +1,146 @@
+"""A ternary occupancy grid (unknown / free / occupied) built from depth images, and its view gain.
+
+The volumetric map of active reconstruction (Isler et al., "An Information Gain
+Formulation for Active Volumetric 3D Reconstruction", ICRA 2016; Delmerico et
+al., "A comparison of volumetric information gain metrics for active 3D object
+reconstruction", Autonomous Robots 42, 2018), kept ternary instead of
+probabilistic:
+
+- `integrate`: every voxel a captured pixel's ray crosses before its hit becomes
+  free; the voxel holding the hit becomes occupied. A pixel with depth 0 (no
+  hit in range) carves free space through the whole grid. Occupied wins over
+  free, now and later: a ray grazing a voxel that holds surface seen elsewhere
+  does not clear it (log-odds maps weigh the two; a ternary map must choose).
+- `gain`: the number of distinct unknown voxels a candidate camera's rays reach,
+  each ray stopping at the first occupied voxel: the "unobserved voxel" gain of
+  both papers with a hard visibility (free and unknown voxels let the ray on,
+  occupied ones stop it), computed by ray casting the grid, rendering nothing.
+
+Depth is z-depth (docs/conventions.md, `render.renderer`): a pixel's ray has
+direction (x, y, 1) in the camera frame (`render.camera.pixel_rays`), so its hit
+lies at range depth * |(x, y, 1)| along the unit direction. Rays are walked by
+sampling every half voxel between their entry into and exit from the grid's box
+(a sample can skip the corner of a voxel the ray clips; the gain is a count of
+voxels, not exact lengths). Vectorised NumPy, in chunks of rays.
+
+Example: a wall 3.5 m in front of a one-pixel camera, in a row of four 1 m voxels.
+    >>> grid = OccupancyGrid(np.zeros(3), np.array([4.0, 1.0, 1.0]), resolution=4)
+    >>> K = np.array([[1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0]])
+    >>> c2w = np.array([[0, 0, 1, -1.0], [1, 0, 0, 0.5], [0, 1, 0, 0.5], [0, 0, 0, 1]])  # looks along +x
+    >>> grid.integrate(np.array([[3.5]], np.float32), K, c2w)
+    >>> grid.state[:, 0, 0].tolist()  # free, free, occupied, unknown
+    [1, 1, 2, 0]
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+
+from render.camera import pixel_rays
+from render.viewpoint import validate_pose
+
+UNKNOWN, FREE, OCCUPIED = 0, 1, 2
+"""Voxel states."""
+CHUNK_SAMPLES = 1 << 21
+"""Ray samples held at once (a few arrays of 2M numbers)."""
+
+
+class OccupancyGrid:
+    """Cubic voxels over an axis-aligned box, each unknown, free or occupied; all unknown at first.
+
+    Args:
+        lower: (3,) the box's lower corner, metres.
+        upper: (3,) its upper corner; the grid reaches at least this far (whole voxels).
+        resolution: voxels along the box's longest side.
+    """
+
+    def __init__(self, lower: np.ndarray, upper: np.ndarray, resolution: int) -> None:
+        self.lower = np.asarray(lower, dtype=np.float64)
+        extent = np.asarray(upper, dtype=np.float64) - self.lower
+        if extent.shape != (3,) or not np.all(np.isfinite(extent)) or np.any(extent <= 0):
+            raise ValueError(f"occupancy grid needs a box with positive extent, got {lower} to {upper}")
+        if resolution < 1:
+            raise ValueError(f"occupancy grid resolution must be >= 1, got {resolution}")
+        self.voxel_size = float(extent.max()) / resolution
+        shape = np.maximum(np.ceil(extent / self.voxel_size - 1e-9), 1).astype(np.int64)
+        self.state = np.zeros(tuple(int(n) for n in shape), dtype=np.uint8)
+        self.upper = self.lower + shape * self.voxel_size
+
+    def integrate(self, depth: np.ndarray, K: np.ndarray, c2w: np.ndarray,  # noqa: N803
+                  stride: int = 1) -> None:
+        """Fold in one z-depth image (H x W metres, 0 for no hit) taken at the OpenCV camera-to-world `c2w`.
+
+        Free space is carved along every `stride`-th pixel's ray; every pixel's hit is marked occupied.
+        """
+        depth = np.asarray(depth, dtype=np.float64)
+        origin, rays = self._rays(K, c2w, depth.shape[1], depth.shape[0])
+        lengths = np.linalg.norm(rays, axis=-1)
+        ranges = np.where(depth > 0, depth * lengths, np.inf)  # z-depth to distance along the unit ray
+        step = slice(None, None, stride)
+        sub_rays, sub_ranges = rays[step, step].reshape(-1, 3), ranges[step, step].reshape(-1)
+        flat = self.state.reshape(-1)
+        for index, valid in self._walk(origin, sub_rays / lengths[step, step].reshape(-1, 1), sub_ranges):
+            free = index[valid]
+            flat[free[flat[free] != OCCUPIED]] = FREE
+        hits = origin + rays[depth > 0] * depth[depth > 0, None]
+        flat[self.voxel_index(hits)[self.contains(hits)]] = OCCUPIED
+
+    def gain(self, K: np.ndarray, c2w: np.ndarray, width: int, height: int,  # noqa: N803
+             stride: int = 1) -> int:
+        """Distinct unknown voxels that every `stride`-th pixel's ray reaches before an occupied voxel."""
+        origin, rays = self._rays(K, c2w, width, height)
+        rays = rays[::stride, ::stride].reshape(-1, 3)
+        flat = self.state.reshape(-1)
+        reached = np.zeros(flat.size, dtype=bool)
+        for index, valid in self._walk(origin, rays / np.linalg.norm(rays, axis=-1, keepdims=True),
+                                       np.full(len(rays), np.inf)):
+            state = flat[index]
+            blocked = np.logical_or.accumulate(valid & (state == OCCUPIED), axis=1)
+            reached[index[valid & ~blocked & (state == UNKNOWN)]] = True
+        return int(reached.sum())
+
+    def contains(self, points: np.ndarray) -> np.ndarray:
+        """(N,) True where a point lies inside the grid's box."""
+        return np.all((points >= self.lower) & (points < self.upper), axis=-1)
+
+    def voxel_index(self, points: np.ndarray) -> np.ndarray:
+        """Flat index of the voxel holding each point (..., 3), clamped into the grid."""
+        ijk = np.floor((points - self.lower) / self.voxel_size).astype(np.int64)
+        ijk = np.clip(ijk, 0, np.array(self.state.shape) - 1)
+        return np.ravel_multi_index(np.moveaxis(ijk, -1, 0), self.state.shape)
+
+    def _rays(self, K: np.ndarray, c2w: np.ndarray, width: int,  # noqa: N803
+              height: int) -> tuple[np.ndarray, np.ndarray]:
+        """The camera centre and the (H, W, 3) world directions of the pixel rays, unit z in the camera."""
+        pose = validate_pose(c2w)
+        return pose[:3, 3], pixel_rays(K, width, height) @ pose[:3, :3].T
+
+    def _walk(self, origin: np.ndarray, directions: np.ndarray,
+              ends: np.ndarray) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        """Per chunk of unit-direction rays: (rays, samples) voxel indices of samples every half voxel
+        inside the box, and whether each sample is before the ray's exit and before its end distance."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            near = (self.lower - origin) / directions
+            far = (self.upper - origin) / directions
+        enter = np.nanmax(np.minimum(near, far), axis=1).clip(min=0.0)
+        leave = np.minimum(np.nanmin(np.maximum(near, far), axis=1), ends)
+        missed = ~(enter < leave)  # rays that miss the box, or end before it
+        enter[missed], leave[missed] = 0.0, 0.0
+        step = self.voxel_size / 2.0
+        start = ((origin - self.lower) / self.voxel_size).astype(np.float32)  # in voxel units from here on
+        units = (directions / self.voxel_size).astype(np.float32)
+        shape = np.array(self.state.shape)
+        strides = np.array([shape[1] * shape[2], shape[2], 1])
+        chunk = max(1, CHUNK_SAMPLES // int(np.ceil(np.linalg.norm(self.upper - self.lower) / step)))
+        for first in range(0, len(directions), chunk):
+            part = slice(first, first + chunk)
+            samples = int(np.ceil((leave[part] - enter[part]).max(initial=0.0) / step))
+            t = (enter[part, None] + (np.arange(samples) + 0.5) * step).astype(np.float32)
+            valid = t < leave[part, None]
+            index = np.zeros(t.shape, dtype=np.int64)
+            for axis in range(3):
+                cell = np.floor(start[axis] + t * units[part, axis, None]).astype(np.int64)
+                index += np.clip(cell, 0, shape[axis] - 1) * strides[axis]
+            yield index, valid

@@ -1,0 +1,110 @@
+"""The occupancy grid: hand-worked carving and gain, the z-depth convention, and a rendered depth image."""
+
+from __future__ import annotations
+
+import numpy as np
+import open3d as o3d
+import pytest
+import trimesh
+
+from nbv.recon.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from render.camera import UAVCamera
+from render.raycast import DepthRaycaster
+from render.renderer import MitsubaRenderer
+from render.settings import RenderSettings
+from render.viewpoint import Viewpoint, viewpoint_to_c2w
+from scenes import load_scene
+
+ONE_PIXEL = np.eye(3)  # f = 1, principal point at pixel (0, 0): the single ray is the optical axis
+ALONG_X = np.array([[0, 0, 1, -1.0], [1, 0, 0, 0.5], [0, 1, 0, 0.5], [0, 0, 0, 1]])  # at x = -1, looks +x
+AGAINST_X = np.array([[0, 0, -1, 5.0], [-1, 0, 0, 0.5], [0, 1, 0, 0.5], [0, 0, 0, 1]])  # at x = 5, looks -x
+
+
+def row_of_four() -> OccupancyGrid:
+    """Four 1 m voxels along x: [0, 4] x [0, 1] x [0, 1]."""
+    grid = OccupancyGrid(np.zeros(3), np.array([4.0, 1.0, 1.0]), resolution=4)
+    assert grid.state.shape == (4, 1, 1) and grid.voxel_size == 1.0
+    return grid
+
+
+def test_one_ray_frees_the_voxels_before_its_hit_and_occupies_the_hit():
+    grid = row_of_four()
+    grid.integrate(np.array([[3.5]], np.float32), ONE_PIXEL, ALONG_X)  # hits x = 2.5, in voxel 2
+    assert grid.state[:, 0, 0].tolist() == [FREE, FREE, OCCUPIED, UNKNOWN]  # behind the hit: unknown
+
+
+def test_no_hit_frees_the_whole_ray_and_a_later_ray_does_not_clear_a_hit():
+    grid = row_of_four()
+    grid.integrate(np.array([[0.0]], np.float32), ONE_PIXEL, ALONG_X)  # depth 0: nothing in range
+    assert grid.state[:, 0, 0].tolist() == [FREE] * 4
+    grid = row_of_four()
+    grid.integrate(np.array([[2.5]], np.float32), ONE_PIXEL, ALONG_X)  # voxel 1 occupied
+    grid.integrate(np.array([[3.5]], np.float32), ONE_PIXEL, ALONG_X)  # a later ray through it
+    assert grid.state[:, 0, 0].tolist() == [FREE, OCCUPIED, OCCUPIED, UNKNOWN]
+
+
+def test_gain_counts_the_unknown_voxels_a_view_reaches_before_an_occupied_one():
+    grid = row_of_four()
+    assert grid.gain(ONE_PIXEL, ALONG_X, 1, 1) == 4  # all unknown: nothing stops the ray
+    grid.integrate(np.array([[3.5]], np.float32), ONE_PIXEL, ALONG_X)
+    assert grid.gain(ONE_PIXEL, ALONG_X, 1, 1) == 0  # the known side: free, then the occupied voxel
+    assert grid.gain(ONE_PIXEL, AGAINST_X, 1, 1) == 1  # the far side: voxel 3, then voxel 2 stops it
+    grid.state[3] = OCCUPIED
+    assert grid.gain(ONE_PIXEL, AGAINST_X, 1, 1) == 0
+
+
+def test_a_ray_that_misses_the_grid_gains_nothing_and_changes_nothing():
+    grid = row_of_four()
+    away = AGAINST_X.copy()
+    away[0, 3] = -1.0  # at x = -1 looking along -x, away from the grid
+    grid.integrate(np.array([[3.5]], np.float32), ONE_PIXEL, away)
+    assert grid.gain(ONE_PIXEL, away, 1, 1) == 0 and np.all(grid.state == UNKNOWN)
+
+
+def test_depth_is_z_depth_not_ray_length():
+    # A wall across a 90-degree view: off-axis rays are longer than their z-depth by up to sqrt(2);
+    # read as ray lengths, the corner pixels would place the wall 30 % too close.
+    camera = UAVCamera(33, 33, focal_mm=18.0)  # fov_x = 90 degrees
+    wall = trimesh.creation.box((0.02, 4.0, 4.0))
+    wall.apply_translation((1.5, 0.0, 0.5))  # front face at x = 1.49
+    c2w = ALONG_X.copy()
+    c2w[:3, 3] = (0.0, 0.0, 0.5)
+    depth = DepthRaycaster([wall], camera.K, camera.width, camera.height).depth(c2w)
+    assert depth.min() == pytest.approx(1.49, abs=1e-4) and depth.max() == pytest.approx(1.49, abs=1e-4)
+    grid = OccupancyGrid(np.array([0.0, -1.6, -1.1]), np.array([3.2, 1.6, 2.1]), resolution=32)  # 0.1 m
+    grid.integrate(depth, camera.K, c2w)
+    occupied_x = np.unique(np.nonzero(grid.state == OCCUPIED)[0])
+    assert occupied_x.tolist() == [14]  # x in [1.4, 1.5): every pixel, corners too
+    assert np.all(grid.state[:14, 16, 16] == FREE)  # along the optical axis, in front of the wall
+
+
+def test_bad_grids_are_refused():
+    with pytest.raises(ValueError, match="positive extent"):
+        OccupancyGrid(np.zeros(3), np.array([1.0, 0.0, 1.0]), 8)
+    with pytest.raises(ValueError, match="resolution"):
+        OccupancyGrid(np.zeros(3), np.ones(3), 0)
+
+
+def test_a_rendered_depth_image_occupies_voxels_on_the_true_surface():
+    scene = load_scene("test_building")
+    camera = UAVCamera(64, 48)
+    renderer = MitsubaRenderer(scene, camera, RenderSettings(spp=1))
+    c2w = viewpoint_to_c2w(Viewpoint(2.0, 0.6, 0.5), renderer.center)
+    lower, upper = scene.bounds()
+    grid = OccupancyGrid(lower - [0.05, 0.05, 0.0], upper + 0.05, resolution=32)
+    grid.integrate(renderer.render_depth(c2w), camera.K, c2w)
+    occupied = np.stack(np.nonzero(grid.state == OCCUPIED), -1)
+    free = np.stack(np.nonzero(grid.state == FREE), -1)
+    assert len(occupied) > 50 and len(free) > 2 * len(occupied)
+    surface = o3d.t.geometry.RaycastingScene()
+    for part in scene.parts:  # the ground too: it is in view
+        surface.add_triangles(np.asarray(part.vertices, np.float32), np.asarray(part.faces, np.uint32))
+
+    def distance(ijk: np.ndarray) -> np.ndarray:
+        centres = grid.lower + (ijk + 0.5) * grid.voxel_size
+        return surface.compute_distance(centres.astype(np.float32)).numpy()
+
+    half_diagonal = np.sqrt(3) / 2 * grid.voxel_size
+    assert distance(occupied).max() <= half_diagonal + 1e-4  # every occupied voxel holds surface
+    near = grid.voxel_size / 2
+    assert np.mean(distance(occupied) < near) > 0.8 > 0.1 > np.mean(distance(free) < near)  # free: off it

@@ -5,7 +5,7 @@ training buildings (`TRAIN_SCENES`) and is scored on validation buildings that n
 (`VALIDATION_SCENES`: training-split `random:SEED` buildings; the test buildings alpine_chalet,
 imperial_temple and random:SEED with SEED % 5 == 0 are never touched here). The score is the policy's
 mode over `--episodes` start views per building, rendered at exact viewpoints, scored by the
-visible-surface coverage of the true mesh (`nbv.planning.visibility`).
+visible-surface coverage of the true mesh (`nbv.recon.visibility`).
 
     python scripts/select_defaults.py train --runs runs/selection --frames 4000 --jobs 2
     python scripts/select_defaults.py score --runs runs/selection --out paper_results/selection
@@ -24,13 +24,12 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-import trimesh
 from tqdm import tqdm
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import git_commit
 from nbv.planning.planners import Planner, PolicyPlanner, make_planner
-from nbv.recon.visibility import visible_coverage
+from nbv.recon.visibility import scene_visibility
 from nbv.rl.config import EnvConfig, LatticeConfig
 from nbv.rl.env import NBVEnv
 from nbv.viz.figures import plot_seed_scores
@@ -84,9 +83,8 @@ def episode_coverage(planner: Planner, env_config: EnvConfig, scene: str, views:
     env = NBVEnv(config, seed=seed)
     chosen = planner.plan(env, views)
     loaded = config.scenes.specs()[0].load()
-    occluders = [trimesh.Trimesh(p.vertices, p.faces, process=False) for p in loaded.parts]
     poses = [viewpoint_to_c2w(v, loaded.center()) for v in chosen]
-    return visible_coverage(occluders, loaded.target_mesh(), config.camera, poses, seed=seed)
+    return scene_visibility(loaded, config.camera, seed=seed).coverage(poses)
 
 
 def validation_score(planner: Planner, env_config: EnvConfig, views: int, episodes: int) -> float:

@@ -71,6 +71,13 @@ class SurfaceVisibility:
         """(points,) True where a sample is seen from the OpenCV camera-to-world `c2w`."""
         return seen_mask(self.samples, self.caster.depth(c2w), self.K, c2w, self.tolerance_m)
 
+    def coverage(self, poses: Sequence[np.ndarray]) -> float:
+        """The share of the samples seen from at least one of the OpenCV camera-to-world `poses`."""
+        seen = np.zeros(len(self.samples), dtype=bool)
+        for pose in poses:
+            seen |= self.seen(pose)
+        return float(seen.mean())
+
 
 def scene_visibility(scene: Scene, camera: UAVCamera, points: int = 20_000, tolerance_m: float = 0.02,
                      seed: int = 0) -> SurfaceVisibility:
@@ -86,8 +93,4 @@ def visible_coverage(occluders: Sequence[trimesh.Trimesh], target: trimesh.Trime
 
     Arguments as `SurfaceVisibility`'s; `poses` are camera-to-world matrices.
     """
-    visibility = SurfaceVisibility(occluders, target, camera, points, tolerance_m, seed)
-    seen = np.zeros(len(visibility.samples), dtype=bool)
-    for pose in poses:
-        seen |= visibility.seen(pose)
-    return float(seen.mean())
+    return SurfaceVisibility(occluders, target, camera, points, tolerance_m, seed).coverage(poses)

@@ -62,7 +62,8 @@ class MitsubaRenderer:
             {"type": self.settings.integrator, "max_depth": self.settings.max_depth}
             if self.settings.integrator == "path" else {"type": "direct"})
         self._depth_integrator = self.mi.load_dict({"type": "aov", "aovs": "dd.y:depth,p:position"})
-        self._guide_integrator = self.mi.load_dict({"type": "aov", "aovs": "albedo:albedo,nn:sh_normal"})
+        self._guide_integrator = (self.mi.load_dict({"type": "aov", "aovs": "albedo:albedo,nn:sh_normal"})
+                                  if self.settings.denoiser != "off" else None)  # the denoiser's guides
         self._views_rendered = 0
 
     def render(self, c2w: np.ndarray, seed: int | None = None) -> tuple[np.ndarray, np.ndarray]:

@@ -8,7 +8,7 @@ APT_STAMP := $(VENV)/.apt-installed
 APT_PACKAGES := libllvm19 libusb-1.0-0 libgomp1
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: setup demo test bench tables clean
+.PHONY: setup demo test bench tables ablations clean
 
 setup: $(STAMP)
 
@@ -37,6 +37,9 @@ bench: setup
 
 tables: setup
 	$(VENV)/bin/nbv tables --out paper_results
+
+ablations: setup
+	$(VENV)/bin/nbv ablate --out paper_results/ablations
 
 clean:
 	rm -rf demo_out bench_out .pytest_cache

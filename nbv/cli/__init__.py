@@ -33,6 +33,7 @@ COMMANDS = {
     "online": Command("online", "the shipped policy against the baselines on held-out buildings"),
     "plot-training": Command("plot_training", "overlay the learning curves of training runs"),
     "demo": Command("demo", "scan, refine, reconstruct and evaluate a built-in scene"),
+    "ablate": Command("ablate", "rendering-quality ablations, one axis at a time (make ablations)"),
     "tables": Command("tables", "reproduce the paper's Table 2 and Fig. 6"),
     "bench": Command("bench", "measure throughput figures (make bench)"),
 }

@@ -79,3 +79,50 @@ def repeatability(keypoints_a: np.ndarray, keypoints_b: np.ndarray, depth_a: np.
         return 0.0
     gaps = np.linalg.norm(pixels[seen][:, None, :] - kb[None, :, :], axis=2).min(axis=1)
     return float(np.mean(gaps <= tol_px))
+
+
+LOWE_RATIO = 0.8
+"""A match is kept when its descriptor distance is below this fraction of the second-nearest's (Lowe 2004)."""
+
+
+def match_descriptors(descriptors_a: np.ndarray, descriptors_b: np.ndarray,
+                      ratio: float = LOWE_RATIO) -> np.ndarray:
+    """(K, 2) index pairs (a, b) of mutual nearest neighbours (Euclidean) that pass Lowe's ratio test."""
+    a = np.asarray(descriptors_a, dtype=np.float64).reshape(-1, np.shape(descriptors_a)[-1])
+    b = np.asarray(descriptors_b, dtype=np.float64).reshape(-1, a.shape[1])
+    if len(a) == 0 or len(b) == 0:
+        return np.zeros((0, 2), dtype=int)
+    dist = np.sqrt(np.maximum((a * a).sum(1)[:, None] + (b * b).sum(1)[None] - 2.0 * a @ b.T, 0.0))
+    nearest_b, nearest_a = dist.argmin(axis=1), dist.argmin(axis=0)
+    mutual = nearest_a[nearest_b] == np.arange(len(a))
+    if len(b) > 1:
+        two = np.sort(dist, axis=1)[:, :2]
+        mutual &= two[:, 0] < ratio * two[:, 1]
+    rows = np.flatnonzero(mutual)
+    return np.stack([rows, nearest_b[rows]], axis=1)
+
+
+def match_inlier_ratio(keypoints_a: np.ndarray, descriptors_a: np.ndarray, keypoints_b: np.ndarray,
+                       descriptors_b: np.ndarray, depth_a: np.ndarray, K_a: np.ndarray, c2w_a: np.ndarray,
+                       K_b: np.ndarray | None = None, c2w_b: np.ndarray | None = None,
+                       depth_b: np.ndarray | None = None, tol_px: float = 1.0) -> float:
+    """Share in [0, 1] of descriptor matches (`match_descriptors`) between A and B that are correct: A's
+    keypoint, carried to B through depth and poses (`carry_keypoints`) and seen there, lands within `tol_px`
+    of its match. Matches of A's keypoints B cannot see do not count; 0 when no match counts.
+
+    Example:
+        >>> K = np.array([[50.0, 0, 31.5], [0, 50, 23.5], [0, 0, 1]])
+        >>> kp, desc = np.array([[10.0, 10], [20, 20]]), np.eye(2)
+        >>> match_inlier_ratio(kp, desc, kp[::-1], desc, np.ones((48, 64)), K, np.eye(4))
+        0.0
+    """
+    K_b = K_a if K_b is None else K_b
+    c2w_b = c2w_a if c2w_b is None else c2w_b
+    pairs = match_descriptors(descriptors_a, descriptors_b)
+    pixels, seen = carry_keypoints(keypoints_a, depth_a, K_a, c2w_a, K_b, c2w_b, depth_b)
+    pairs = pairs[seen[pairs[:, 0]]] if len(pairs) else pairs
+    if len(pairs) == 0:
+        return 0.0
+    kb = np.asarray(keypoints_b, dtype=np.float64).reshape(-1, 2)
+    gaps = np.linalg.norm(pixels[pairs[:, 0]] - kb[pairs[:, 1]], axis=1)
+    return float(np.mean(gaps <= tol_px))

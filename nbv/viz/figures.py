@@ -86,7 +86,7 @@ def plot_trajectory(poses: np.ndarray, mesh: trimesh.Trimesh, out: str | Path, t
     fig.colorbar(sc, ax=top, label="capture order (0 = first)")
     if title:
         fig.suptitle(title)
-    return _save(fig, out)
+    return save_figure(fig, out)
 
 
 def plot_planner_comparison(runs: Sequence[dict], paper: dict, out: str | Path, title: str = "") -> Path:
@@ -114,7 +114,7 @@ def plot_planner_comparison(runs: Sequence[dict], paper: dict, out: str | Path, 
         ax.legend(fontsize=8)
     if title:
         fig.suptitle(title)
-    return _save(fig, out)
+    return save_figure(fig, out)
 
 
 def plot_seed_scores(scores: dict[str, Sequence[float]], out: str | Path, ylabel: str, title: str = "",
@@ -134,7 +134,7 @@ def plot_seed_scores(scores: dict[str, Sequence[float]], out: str | Path, ylabel
         ax.legend(fontsize=8)
     if title:
         ax.set_title(title)
-    return _save(fig, out)
+    return save_figure(fig, out)
 
 
 def training_curves(csv_path: str | Path, window: int = 500) -> dict[str, np.ndarray]:
@@ -182,7 +182,7 @@ def plot_training_curves(runs: dict[str, str | Path], out: str | Path, window: i
         ax.set(xlabel="frames (environment steps)", title=f"{title} (last {window} frames)")
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=8)
-    return _save(fig, out)
+    return save_figure(fig, out)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -242,10 +242,10 @@ def plot_table2(rows: Sequence[dict], path: str | Path) -> Path:
             ax.set_xticks(list(x), [f"{r['ranges']}/{r['words']}" for r in mine], rotation=45, fontsize=8)
             ax.set(ylabel=unit, xlabel="N ranges / W words", title=scene)
             ax.legend(fontsize=8)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
-def _save(fig: Figure, out: str | Path) -> Path:
+def save_figure(fig: Figure, out: str | Path) -> Path:
     """Lay out a figure and write it as PNG, atomically."""
     fig.tight_layout()
     path = Path(out)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from nbv.features.repeatability import carry_keypoints, repeatability
+from nbv.features.repeatability import carry_keypoints, match_descriptors, match_inlier_ratio, repeatability
 
 K = np.array([[50.0, 0.0, 31.5], [0.0, 50.0, 23.5], [0.0, 0.0, 1.0]])
 PLANE = np.full((48, 64), 2.0)  # a wall 2 m in front of camera A
@@ -42,3 +42,24 @@ def test_points_leaving_the_image_without_depth_or_hidden_do_not_count():
 def test_the_tolerance_is_a_pixel_distance(tol, expected):
     found = np.array([[10.0, 10.0]])
     assert repeatability(found, found + [0.6, 0.6], PLANE, K, np.eye(4), tol_px=tol) == expected
+
+
+def test_matches_are_mutual_nearest_neighbours_that_pass_the_ratio_test():
+    a = np.array([[1.0, 0.0], [0.0, 1.0], [0.7, 0.7]])
+    b = np.array([[0.0, 1.0], [1.0, 0.05], [0.95, 0.0]])
+    # a0 -> b2 (0.05 vs b1 at 0.05: tie fails the ratio); a1 -> b0; a2's nearest b1 prefers a0 -> not mutual.
+    pairs = match_descriptors(a, b)
+    assert pairs.tolist() == [[1, 0]]
+    assert match_descriptors(a, b[:0]).shape == (0, 2)
+
+
+def test_the_inlier_ratio_counts_matches_landing_at_the_carried_point():
+    keypoints = np.array([[10.0, 5.0], [40.0, 30.0]])
+    desc = np.eye(2)
+    pixels, _ = carry_keypoints(keypoints, PLANE, K, np.eye(4), K, shifted(0.1))
+    step = (PLANE, K, np.eye(4), K, shifted(0.1))
+    right = match_inlier_ratio(keypoints, desc, pixels + [0.5, 0.0], desc, *step)
+    wrong = match_inlier_ratio(keypoints, desc, pixels[::-1], desc, *step)
+    half = match_inlier_ratio(keypoints, desc, np.array([pixels[0], pixels[1] + [3.0, 0.0]]), desc, PLANE, K,
+                              np.eye(4), K, shifted(0.1))
+    assert (right, wrong, half) == (1.0, 0.0, 0.5)

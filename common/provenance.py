@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import json
 import subprocess
 import types
@@ -66,3 +67,14 @@ def git_commit() -> str:
         return _git("rev-parse", "--short", "HEAD") + dirty
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
+
+
+def run_cache(kind: str, config: Any, unkeyed: tuple[str, ...] = ()) -> Path:
+    """A cache folder for the work units of a study: `$NBV_CACHE_DIR/<kind>/<key>`, keyed by the config's
+    fields (but `unkeyed`, those that only choose which units run) and the commit, so an interrupted run
+    resumes and a run at another commit measures afresh."""
+    from common.io import cache_dir
+
+    record = {k: v for k, v in config_record(config).items() if k not in unkeyed}
+    key = hashlib.sha1(json.dumps([record, git_commit()], sort_keys=True, default=str).encode()).hexdigest()
+    return cache_dir() / kind / key[:16]

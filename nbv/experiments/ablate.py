@@ -37,7 +37,7 @@ from PIL import Image
 from tyro.conf import UseAppendAction, arg
 
 from common.io import atomic_path, cache_dir, write_json
-from common.provenance import config_record, git_commit
+from common.provenance import git_commit, run_cache
 from common.threads import apply_thread_policy
 from nbv.bov.config import BoVConfig
 from nbv.experiments.ablation_axes import AXES, REFERENCE, Level, apply_level, check_axes
@@ -74,13 +74,13 @@ class AblateConfig(MeshOrientation):
     """The camera of every scan (a resolution level scales it)."""
     render: RenderSettings = RenderSettings()
     """The reference render settings every level changes one thing of."""
-    plan: HemispherePlan = HemispherePlan(end_overlap=0.5, side_overlap=0.4)
-    """The hemisphere scan each level renders and refines (34 views by default)."""
+    plan: HemispherePlan = HemispherePlan(end_overlap=0.4, side_overlap=0.3)
+    """The hemisphere scan each level renders and refines (25 views by default)."""
     bov: BoVConfig = BoVConfig()
     """The Bag of Views of the refinement (paper Alg. 1) and its features."""
     recon: ReconstructionConfig = ReconstructionConfig()
     """TSDF fusion of the kept views."""
-    metrics: MetricsConfig = MetricsConfig(n_points=50_000)
+    metrics: MetricsConfig = MetricsConfig(n_points=30_000)
     """How reconstructions are compared with the ground truth."""
     reference_spp: int = 256
     """Samples per pixel of the reference render of the quality views."""
@@ -90,8 +90,9 @@ class AblateConfig(MeshOrientation):
     """Repeatability and match radius, pixels of the reference render."""
     greedy_views: int = 13
     """Views of the greedy Bag of Views plan scored on lighting axes (paper Fig. 1's count)."""
-    greedy_candidates: int = 8
-    """Candidate viewpoints the greedy planner renders per step."""
+    greedy_candidates: int = 4
+    """Candidate viewpoints the greedy planner renders per step (`nbv plan` takes 8; 4 keeps
+    `make ablations` within the hour)."""
     quick: bool = False
     """A small run (one building, one seed, a small camera and scan): the defaults of `QUICK`."""
 
@@ -159,13 +160,6 @@ def units(config: AblateConfig) -> list[Unit]:
             out += [Unit(scene, name, level, seed) for name in config.axes
                     for level in AXES[name].levels if not level.is_reference]
     return out
-
-
-def run_folder(config: AblateConfig) -> Path:
-    """The cache folder of this run's units: keyed by every setting but the output folder, and the commit."""
-    record = {k: v for k, v in config_record(config).items() if k not in ("out", "axis", "scene", "seeds")}
-    key = hashlib.sha1(json.dumps([record, git_commit()], sort_keys=True, default=str).encode()).hexdigest()
-    return cache_dir() / "ablations" / key[:16]
 
 
 def unit_path(folder: Path, unit: Unit) -> Path:
@@ -305,7 +299,7 @@ def run_ablations(config: AblateConfig, progress: Progress | None = None) -> lis
     `config.out`; returns the units' documents."""
     from nbv.experiments.ablation_report import write_report
 
-    folder = run_folder(config)
+    folder = run_cache("ablations", config, unkeyed=("out", "axis", "scene", "seeds"))
     start = time.perf_counter()
     docs = []
     for unit in units(config):

@@ -14,6 +14,11 @@ start-view RNG, Bag of Views). So a one-worker run stopped and resumed ends
 with the same parameters as one that ran through. With parallel workers the
 workers' episodes in flight are lost at a restart: they start new episodes,
 seeded `seed + frames done`, and everything else resumes exactly.
+
+Across machines, `--collector ray --collectors K` collects on K Ray actors
+(TorchRL's `RayCollector`), each building its own env; the learner, replay
+buffer and checkpoints stay here, and a restart loses the actors' episodes in
+flight as with parallel workers.
 """
 
 from __future__ import annotations
@@ -38,6 +43,7 @@ from nbv.rl.builders import (
     make_environment,
     make_loss_module,
     make_optimizers,
+    make_ray_collector,
     make_replay_buffer,
     make_sac_agent,
 )
@@ -108,11 +114,15 @@ def train(config: TrainConfig) -> Path:
             return ckpt_path  # the budget is already spent: nothing to do
 
     # Environment and collector (random actions until init_random_frames).
-    envs = config.collector.envs
-    env = make_environment(config.env, envs, seed + frames)
-    if resumed is not None and envs == 1:
-        env.base_env.restore(resumed["env"])
-    collector = make_collector(env, actor, config.collector, frames)
+    env = None
+    if config.collector.collector == "ray":
+        collector = make_ray_collector(config.env, actor, config.collector, seed + frames, frames)
+    else:
+        env = make_environment(config.env, config.collector.envs, seed + frames)
+        collector = make_collector(env, actor, config.collector, frames)
+    in_process = env.base_env if env is not None and config.collector.envs == 1 else None
+    if resumed is not None and in_process is not None:
+        in_process.restore(resumed["env"])
     if resumed is not None:
         set_rng_state(resumed["rng"])  # after every builder: construction draws random numbers too
 
@@ -164,7 +174,7 @@ def train(config: TrainConfig) -> Path:
                     csv_file.flush()
                     plot_training_curves({run.name: csv_path}, run / "training.png")
                     write_checkpoint(ckpt_path, config, loss_module, optim_actor, optim_critic, buffer,
-                                     frames, updates, env.base_env if envs == 1 else None)
+                                     frames, updates, in_process)
                     last_ckpt = frames
                 start = time.perf_counter()
     finally:

@@ -18,14 +18,19 @@ from nbv.dist.task import Task, run_task
 from render.variant import configure_libllvm
 
 
+def usable_cores() -> int:
+    """Cores this process may run on (its CPU affinity, which a container or `taskset` may narrow)."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
 def core_share(workers: int, cores: int | None = None) -> int:
-    """Cores per worker when `workers` share this machine's (or `cores`) cores; at least 1.
+    """Cores per worker when `workers` share `cores` (default: `usable_cores()`); at least 1.
 
     Example:
         >>> core_share(2, cores=16), core_share(4, cores=2)
         (8, 1)
     """
-    return max(1, (cores or os.cpu_count() or 1) // workers)
+    return max(1, (cores or usable_cores()) // workers)
 
 
 def cap_threads(share: int) -> tuple[int, int]:

@@ -114,15 +114,16 @@ def train(config: TrainConfig) -> Path:
             return ckpt_path  # the budget is already spent: nothing to do
 
     # Environment and collector (random actions until init_random_frames).
-    env = None
+    in_process = None  # the env whose state checkpoints carry: one in this process
     if config.collector.collector == "ray":
         collector = make_ray_collector(config.env, actor, config.collector, seed + frames, frames)
     else:
         env = make_environment(config.env, config.collector.envs, seed + frames)
+        if config.collector.envs == 1:
+            in_process = env.base_env
+            if resumed is not None:
+                in_process.restore(resumed["env"])  # before the collector, which resets the env
         collector = make_collector(env, actor, config.collector, frames)
-    in_process = env.base_env if env is not None and config.collector.envs == 1 else None
-    if resumed is not None and in_process is not None:
-        in_process.restore(resumed["env"])
     if resumed is not None:
         set_rng_state(resumed["rng"])  # after every builder: construction draws random numbers too
 

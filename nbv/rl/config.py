@@ -20,6 +20,7 @@ from tyro.conf import arg
 
 from common.threads import WORKER_THREADS
 from nbv.bov.config import BoVConfig
+from nbv.dist.config import ExecutorConfig
 from render.camera import UAVCamera
 from render.scan import check_camera_distance
 from render.settings import RenderSettings
@@ -261,3 +262,6 @@ class TrainConfig:
     """Network sizes."""
     logger: LoggerConfig
     """Logs and checkpoints."""
+    executor: ExecutorConfig = ExecutorConfig()
+    """Where the scenes' view lattices are rendered before training (--lattice): this process, local
+    workers or Ray."""

@@ -38,6 +38,7 @@ from tqdm import tqdm
 from common.io import write_json
 from common.provenance import config_from_record, config_record
 from common.threads import set_torch_threads
+from nbv.dist.executor import run_tasks
 from nbv.rl.builders import (
     make_collector,
     make_environment,
@@ -59,16 +60,18 @@ from nbv.rl.checkpoint import (
 )
 from nbv.rl.config import TrainConfig
 from nbv.rl.env import NBVEnv
+from nbv.rl.lattice import lattice_tasks
 from nbv.viz.figures import plot_training_curves
 
 CHECKPOINT = "checkpoint.pt"
 POLICY = "policy.pt"
 """The actor and config alone (a few MB, for planning), written beside every checkpoint."""
 RESUMABLE_CHANGES = ("collector.frames", "collector.threads", "logger.out", "logger.checkpoint_every",
-                     "logger.progress")
+                     "logger.progress", "executor.workers", "executor.ray")
 """Settings a resumed run may change, as dotted paths into the nested config record (a difference
 anywhere else, e.g. `env.bov.match_cosine` or `env.camera.width`, is refused). Threads change speed, and
-at most float rounding: runs recorded before the thread policy (threads 0) resume under its default 1."""
+at most float rounding: runs recorded before the thread policy (threads 0) resume under its default 1.
+Where the lattices are rendered changes nothing but speed."""
 CSV_FIELDS = ("frames", "updates", "reward_mean", "episode_return", "episodes", "loss_actor", "loss_qvalue",
               "entropy", "alpha", "collect_s", "update_s")
 
@@ -112,6 +115,10 @@ def train(config: TrainConfig) -> Path:
         frames, updates = int(resumed["counters"]["frames"]), int(resumed["counters"]["updates"])
         if frames >= config.collector.frames:
             return ckpt_path  # the budget is already spent: nothing to do
+
+    # The scenes' view lattices, rendered side by side where the executor says; envs then read the cache.
+    if config.env.lattice.enabled:
+        run_tasks(lattice_tasks(config.env), config.executor)
 
     # Environment and collector (random actions until init_random_frames).
     in_process = None  # the env whose state checkpoints carry: one in this process

@@ -22,7 +22,7 @@ $(STAMP): pyproject.toml $(APT_STAMP)
 	$(PY) -m pip install -q --upgrade pip
 	# The pinned CPU wheel first: an unpinned torch would pull gigabytes of CUDA packages.
 	$(PY) -m pip install -q torch==2.13.0
-	$(PY) -m pip install -q -e '.[dev]'
+	$(PY) -m pip install -q -e '.[dev,ray]'
 	@touch $@
 
 demo: setup

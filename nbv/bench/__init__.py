@@ -20,6 +20,7 @@ AREAS = (
     "recon",
     "threads",
     "rl",
+    "fanout",
 )
 """Bench modules under `nbv.bench`, run in this order."""
 
@@ -29,7 +30,7 @@ class BenchResult:
     """One measured figure."""
 
     area: str
-    """The bench module that measured it (cli, render, scenes, bov, recon, threads, rl)."""
+    """The bench module that measured it (cli, render, scenes, bov, recon, threads, rl, fanout)."""
     name: str
     """What was measured, with its settings (e.g. 'RGB-D views/s llvm_ad_rgb 320x240 steady')."""
     value: float

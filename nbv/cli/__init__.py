@@ -11,6 +11,8 @@ import importlib
 import sys
 from typing import NamedTuple
 
+from nbv.dist.task import WorkerDied
+
 
 class Command(NamedTuple):
     """A sub-command: the module under `nbv.cli` that runs it and its one-line help."""
@@ -39,8 +41,9 @@ COMMANDS = {
 }
 """Sub-command name -> where it lives, in `--help` order."""
 
-ERRORS = (ValueError, FileExistsError, FileNotFoundError, PermissionError)
-"""Exceptions that are the user's input at fault: reported in one line, exit status 2."""
+ERRORS = (ValueError, FileExistsError, FileNotFoundError, PermissionError, WorkerDied)
+"""Exceptions reported in one line, exit status 2: the user's input at fault, or a unit of work whose
+worker died twice (it is named)."""
 
 
 def usage() -> str:

@@ -9,7 +9,11 @@ over seeds (docs/rl.md §10). Example (paper_results/planners):
         --seeds 0 1 2 --out cmp
 
 Each run is its own `nbv plan` output folder, written atomically as it finishes
-(an interrupted comparison keeps the runs done); the comparison files
+(an interrupted comparison keeps the runs done). The runs are independent units
+(`comparison_tasks`): `--workers N` runs them on N local processes, `--ray auto`
+or `--ray ADDRESS` on Ray (`nbv.dist`), with the same files and numbers as in
+this process. The full-scan reference of the scene is made first, once, so the
+runs never render it side by side. The comparison files
 (`OUTPUTS`) are swapped onto `--out` together at the end (`common.io.atomic_folder`),
 the run folders carried over as hard links, so they always describe the same runs.
 """
@@ -17,15 +21,18 @@ the run folders carried over as hard links, so they always describe the same run
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from pathlib import Path
 
 import numpy as np
 
 from common.io import atomic_folder, write_json, write_text
 from common.provenance import config_record, git_commit
+from nbv.dist.config import ExecutorConfig
+from nbv.dist.executor import run_stages
+from nbv.dist.task import Task
 from nbv.experiments.paper_numbers import FIG1_NBV
-from nbv.planning.plan import PlanSettings, plan_scan
+from nbv.planning.plan import PlanSettings, plan_scan, reference_mesh
 from nbv.planning.planners import planner_label
 from nbv.viz.figures import plot_planner_comparison
 
@@ -45,6 +52,8 @@ class CompareConfig(PlanSettings):
     out: Path
     """Folder of the runs (<planner label>-seed<seed>/, each an `nbv plan` output) and of
     comparison.{json,md,png}; runs already there are read back, not redone."""
+    executor: ExecutorConfig = ExecutorConfig()
+    """Where the runs run: this process, local workers or Ray (not recorded: it changes no number)."""
 
     def __post_init__(self) -> None:
         if not self.planners or not self.seeds:
@@ -63,6 +72,28 @@ COMPARED = (("coverage", "reference", 100.0, "coverage % (ref)"),
 (`reference`); the same metrics against the ground-truth mesh (`gt`) follow."""
 
 
+def run_folder(config: CompareConfig, planner: str, seed: int) -> Path:
+    """The `nbv plan` output folder of one planner and seed: `out/<planner label>-seed<seed>`."""
+    return Path(config.out) / f"{planner_label(planner)}-seed{seed}"
+
+
+def comparison_tasks(config: CompareConfig) -> tuple[list[Task], list[Task]]:
+    """The comparison's units, in two stages: making the full-scan reference (one unit, always run: it is
+    cached), then one `plan_scan` per planner and seed, done once its `plan.json` exists."""
+    # The reference depends on neither the view count nor the planner: one unit per scene and settings.
+    shared = {f.name: getattr(config, f.name) for f in fields(PlanSettings) if f.name != "views"}
+    reference = Task(f"full-scan reference of {config.scene.scene}", reference_mesh,
+                     {"config": PlanSettings(**shared)})
+    runs = []
+    for planner in config.planners:
+        for seed in config.seeds:
+            folder = run_folder(config, planner, seed)
+            runs.append(Task(f"{folder.name} in {folder.parent}", plan_scan,
+                             {"config": config.plan_config(planner, seed, folder, overwrite=True)},
+                             folder / "plan.json"))
+    return [reference], runs
+
+
 def compare_planners(config: CompareConfig) -> str:
     """Run `plan_scan` for every planner and seed; write comparison.{json,md,png}; return the table.
 
@@ -70,26 +101,26 @@ def compare_planners(config: CompareConfig) -> str:
     The table gives mean +- std over seeds beside the paper's Fig. 1 (13 views, SAC policy).
     """
     out = Path(config.out)
+    reference, plans = comparison_tasks(config)
+    if not all(task.done() for task in plans):
+        run_stages([reference, plans], config.executor)
     runs = []
     for planner in config.planners:
-        label = planner_label(planner)
         for seed in config.seeds:
-            folder = out / f"{label}-seed{seed}"
-            if (folder / "plan.json").is_file():
-                doc = json.loads((folder / "plan.json").read_text())
-            else:
-                doc = plan_scan(config.plan_config(planner, seed, folder, overwrite=True))
-            runs.append({"planner": label, "seed": seed,
+            doc = json.loads((run_folder(config, planner, seed) / "plan.json").read_text())
+            runs.append({"planner": planner_label(planner), "seed": seed,
                          **{k: doc[k] for k in ("views", "gt", "reference", "planning_s", "deciding_s")}})
     scene = config.scene.scene
     table = comparison_table(runs, scene, config.metrics.threshold_cm)
+    record = config_record(config)
+    del record["executor"]
     with atomic_folder(out, overwrite=True, outputs=OUTPUTS) as folder:
         write_text(folder / "comparison.md", table)
         plot_planner_comparison(runs, FIG1_NBV, folder / "comparison.png",
                                 f"Planners on {Path(scene).name}, {len(config.seeds)} seeds")
         write_json(folder / "comparison.json", {
             "scene": scene, "seeds": list(config.seeds), "planners": list(config.planners),
-            "commit": git_commit(), "config": config_record(config), "runs": runs, "paper_fig1": FIG1_NBV})
+            "commit": git_commit(), "config": record, "runs": runs, "paper_fig1": FIG1_NBV})
     return table
 
 

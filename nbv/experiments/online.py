@@ -10,6 +10,10 @@ Two protocols per building, each an `nbv compare` folder (runs already there are
 and the policy's margins over random, circle and greedy Bag of Views with its planning speed-up
 over greedy (issue 11's acceptance figures), then the one-pass table. The buildings default to
 the held-out ones: nothing here trains or tunes anything.
+
+Every (planner, seed, building, protocol) run is an independent unit: all of them are handed to the
+executor at once (`--workers N`, `--ray auto|ADDRESS`; `nbv.dist`), after each building's full-scan
+reference, so the buildings run side by side as well as the seeds.
 """
 
 from __future__ import annotations
@@ -22,7 +26,9 @@ import numpy as np
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import config_record, git_commit
-from nbv.experiments.compare import CompareConfig, compare_planners
+from nbv.dist.config import ExecutorConfig
+from nbv.dist.executor import run_stages
+from nbv.experiments.compare import CompareConfig, compare_planners, comparison_tasks
 from nbv.experiments.paper_numbers import FIG1_NBV, FIG7_GENERALISATION
 from nbv.planning.planners import planner_label
 from nbv.recon.config import MetricsConfig
@@ -59,6 +65,8 @@ class OnlineConfig:
     """How views are rendered (the Mitsuba variant included)."""
     metrics: MetricsConfig = MetricsConfig(n_points=200_000)
     """How reconstructions are scored (200k points per surface, as `nbv demo` and `nbv tables`)."""
+    executor: ExecutorConfig = ExecutorConfig()
+    """Where the runs run: this process, local workers or Ray (not recorded: it changes no number)."""
 
     def __post_init__(self) -> None:
         if not (self.scenes and self.policies and self.seeds):
@@ -72,30 +80,45 @@ def scene_folder(scene: str) -> str:
     return Path(scene.replace(":", "_")).name
 
 
+def comparisons(config: OnlineConfig) -> list[CompareConfig]:
+    """The `nbv compare` runs of the evaluation: per building, the fixed budget, then one pass if asked."""
+    found = []
+    for scene in config.scenes:
+        common = {"scene": SceneSpec(scene=scene), "render": config.render, "metrics": config.metrics,
+                  "seeds": config.seeds, "executor": config.executor}
+        folder = Path(config.out) / scene_folder(scene)
+        found.append(CompareConfig(**common, views=config.views, out=folder / f"views{config.views}",
+                                   planners=(*config.policies, *config.baselines)))
+        if config.one_pass:
+            found.append(CompareConfig(**common, planners=config.policies[:1], out=folder / "onepass"))
+    return found
+
+
 def run_online(config: OnlineConfig) -> str:
     """Run (or read back) every comparison; write online.{md,json,png}; return the Markdown."""
     out = Path(config.out)
+    compared = comparisons(config)
+    stages = [comparison_tasks(comparison) for comparison in compared]
+    if not all(task.done() for _, plans in stages for task in plans):
+        run_stages([[task for references, _ in stages for task in references],
+                    [task for _, plans in stages for task in plans]], config.executor)
     budget, one_pass = {}, {}
-    for scene in config.scenes:
-        common = {"scene": SceneSpec(scene=scene), "render": config.render, "metrics": config.metrics,
-                  "seeds": config.seeds}
-        folder = out / scene_folder(scene)
-        compare_planners(CompareConfig(**common, views=config.views, out=folder / f"views{config.views}",
-                                       planners=(*config.policies, *config.baselines)))
-        budget[scene] = _runs(folder / f"views{config.views}")
-        if config.one_pass:
-            compare_planners(CompareConfig(**common, planners=config.policies[:1], out=folder / "onepass"))
-            one_pass[scene] = _runs(folder / "onepass")
+    for comparison in compared:
+        compare_planners(comparison)
+        found = budget if comparison.views is not None else one_pass
+        found[comparison.scene.scene] = _runs(comparison.out)
     policy = planner_label(config.policies[0])
     text = online_report(budget, one_pass, policy, config)
     coverage = {label: [np.mean(_values(runs[label], "gt", "coverage")) * 100 for runs in budget.values()]
                 for label in next(iter(budget.values()))}
+    record = config_record(config)
+    del record["executor"]
     with atomic_folder(out, overwrite=True, outputs=OUTPUTS) as folder:
         write_text(folder / "online.md", text)
         plot_seed_scores(coverage, folder / "online.png",
                          f"coverage % of the true surface, {config.views} views",
                          f"mean over {len(config.seeds)} seeds; one dot per building")
-        write_json(folder / "online.json", {"commit": git_commit(), "config": config_record(config),
+        write_json(folder / "online.json", {"commit": git_commit(), "config": record,
                                             "budget": budget, "one_pass": one_pass})
     return text
 

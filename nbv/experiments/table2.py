@@ -8,7 +8,10 @@ Chamfer) and with the ground-truth mesh (which the paper did not have).
 Every number written here comes from this run; the paper's stand in their own
 labelled columns.
 
-The Fig. 6 heat maps are drawn into a scratch folder while measuring; at the end
+Each building is a unit of work (`measure_scene_unit`: its rows and heat maps,
+written atomically into a scratch folder beside `--out`), so `--workers N` or
+`--ray auto|ADDRESS` measure the buildings side by side (`nbv.dist`; on a
+cluster the scratch folder must be shared). At the end
 the tables, the chart and `fig6/` (`OUTPUTS`) are swapped onto `--out` together
 (`common.io.atomic_folder`): an interrupted run keeps the previous results whole,
 and what else `--out` holds (e.g. `paper_results/planners/`) is carried over,
@@ -17,6 +20,7 @@ only in the last seconds, so a run writing there meanwhile is not lost.
 
 from __future__ import annotations
 
+import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -27,6 +31,9 @@ from common.provenance import config_record, git_commit
 from nbv.bov.config import BoVRule
 from nbv.bov.refine import DatasetRun, Progress, kept_view_grid, load_views
 from nbv.bov.sweep import PAPER_RANGES, PAPER_WORDS, write_csv
+from nbv.dist.config import ExecutorConfig
+from nbv.dist.executor import run_tasks
+from nbv.dist.task import Task
 from nbv.experiments.paper_numbers import FULL_SCAN_VIEWS, TABLE2, TABLE2_RANGES, TABLE2_WORDS
 from nbv.experiments.study import FullScanStudy
 from nbv.recon.heatmap import write_heatmap
@@ -57,6 +64,9 @@ class TablesConfig(FullScanStudy):
     """W values of the grid (words per view range)."""
     rule: BoVRule = BoVRule()
     """The Bag of Views rule and features of every cell."""
+    executor: ExecutorConfig = ExecutorConfig()
+    """Where the buildings are measured: this process, local workers or Ray (not recorded: it changes no
+    number)."""
 
 
 def paper_cell(scene: str, n: int, w: int) -> dict[str, Any]:
@@ -109,6 +119,15 @@ def measure_scene(name: str, config: TablesConfig, progress: Progress | None = N
     return rows
 
 
+def measure_scene_unit(name: str, config: TablesConfig, folder: Path,
+                       progress: Progress | None = None) -> None:
+    """`measure_scene` as a unit of work: `folder/rows.json` and the heat maps in `folder/fig6/`, written
+    together (`common.io.atomic_folder`)."""
+    with atomic_folder(folder, overwrite=True) as tmp:
+        (tmp / "fig6").mkdir()
+        write_text(tmp / "rows.json", json.dumps(measure_scene(name, config, progress, tmp / "fig6")))
+
+
 def _tick(progress: Progress | None) -> None:
     if progress is not None:
         progress(1)
@@ -126,10 +145,25 @@ def run_tables(config: TablesConfig, progress: Progress | None = None) -> list[d
     """
     out = Path(config.out)
     start = time.perf_counter()
-    with scratch_folder(out) as fig6:
-        rows = [row for name in config.scenes for row in measure_scene(name, config, progress, fig6)]
+    with scratch_folder(out) as work:
+        # In this process the rows tick one by one; elsewhere a building's rows tick when it is done.
+        here = config.executor.ray is None and config.executor.workers == 1
+        units = [Task(f"Table 2 rows of {name} (scene {i})", measure_scene_unit,
+                      {"name": name, "config": config, "folder": work / f"scene{i}",
+                       "progress": progress if here else None}, work / f"scene{i}" / "rows.json")
+                 for i, name in enumerate(config.scenes)]
+        per_scene = 1 + len(config.ranges) * len(config.words)
+        run_tasks(units, config.executor, None if here or progress is None else lambda _: progress(per_scene))
+        rows, fig6 = [], work / "fig6"
+        fig6.mkdir()
+        for unit in units:
+            rows += json.loads(unit.result.read_text())
+            for image in sorted((unit.result.parent / "fig6").iterdir()):
+                image.rename(fig6 / image.name)
+        record = config_record(config)
+        del record["executor"]
         header = {"command": f"make tables  (nbv tables --out {out})", "commit": git_commit(),
-                  "seconds": round(time.perf_counter() - start, 1), "config": config_record(config)}
+                  "seconds": round(time.perf_counter() - start, 1), "config": record}
         with atomic_folder(out, overwrite=True, outputs=OUTPUTS) as folder:
             fig6.rename(folder / "fig6")
             write_csv(folder / "table2.csv", rows, fieldnames=list(rows[-1]))

@@ -149,7 +149,7 @@ def flown_seconds(seconds: float, rendered: int, flown: int) -> float:
     return seconds / rendered * min(rendered, flown) if rendered else 0.0
 
 
-def reference_mesh(config: PlanConfig, scene: Scene | None = None) -> Path:
+def reference_mesh(config: PlanSettings, scene: Scene | None = None) -> Path:
     """The full hemisphere scan's reconstruction (paper Sec. V-B), cached inside the cached scan's folder.
 
     The scan comes from `render.scan_cache.full_scan`, re-rendered only when the scene, camera or

@@ -5,16 +5,19 @@ Each takes its group of `nbv.rl.config` (defaults: the paper's Table 1, docs/rl.
 
 from __future__ import annotations
 
+import os
 from functools import partial
 
 import torch
 from torchrl.collectors import Collector
+from torchrl.collectors.distributed import RayCollector
 from torchrl.data import ListStorage, TensorDictReplayBuffer
 from torchrl.data.replay_buffers import RandomSampler
 from torchrl.envs import EnvBase, ParallelEnv, RewardSum, TransformedEnv
 from torchrl.modules import ProbabilisticActor, ValueOperator
 from torchrl.objectives import SACLoss, SoftUpdate
 
+from nbv.dist.worker import cap_threads
 from nbv.rl.agent import make_actor, make_critic
 from nbv.rl.config import (
     CollectorConfig,
@@ -24,6 +27,11 @@ from nbv.rl.config import (
     ReplayBufferConfig,
 )
 from nbv.rl.env import NBVEnv
+
+RAY_COLLECTOR_CPUS = 1
+"""CPUs a Ray collector actor asks for, and the threads its Dr.Jit and torch get."""
+RAY_COLLECTOR_MEMORY = 1024**3
+"""Memory a Ray collector actor reserves: one renderer, one env, a policy copy."""
 
 
 def make_environment(config: EnvConfig, envs: int, seed: int) -> EnvBase:
@@ -75,11 +83,46 @@ def make_replay_buffer(config: ReplayBufferConfig) -> TensorDictReplayBuffer:
                                   batch_size=config.batch_size)
 
 
+def _random_frames(config: CollectorConfig, frames_done: int) -> int:
+    """Random-action frames still to take, rounded up to whole batches."""
+    remaining = max(0, config.init_random_frames - frames_done)
+    return -(-remaining // config.frames_per_batch) * config.frames_per_batch
+
+
 def make_collector(env: EnvBase, actor: ProbabilisticActor, config: CollectorConfig,
                    frames_done: int = 0) -> Collector:
     """A collector for the frames still to collect; random actions until `init_random_frames` overall."""
-    remaining_random = max(0, config.init_random_frames - frames_done)
-    remaining_random = -(-remaining_random // config.frames_per_batch) * config.frames_per_batch
     return Collector(env, actor, frames_per_batch=config.frames_per_batch,
-                     total_frames=config.frames - frames_done, init_random_frames=remaining_random,
+                     total_frames=config.frames - frames_done,
+                     init_random_frames=_random_frames(config, frames_done),
                      track_traj_ids=False, auto_register_policy_transforms=False)
+
+
+def make_worker_env(config: EnvConfig, index: int, seed: int) -> EnvBase:
+    """A Ray collector's env, built inside its actor: Dr.Jit and torch capped to the actor's one core
+    (`nbv.dist.worker`), the Mitsuba variant chosen there, returns summed as `make_environment`'s."""
+    cap_threads(RAY_COLLECTOR_CPUS)
+    return TransformedEnv(NBVEnv(config, index, seed), RewardSum())
+
+
+def make_ray_collector(env: EnvConfig, actor: ProbabilisticActor, config: CollectorConfig, seed: int,
+                       frames_done: int = 0) -> RayCollector:
+    """`config.collectors` Ray actors of one env each (collector i seeded `seed + i`, starting at scene i),
+    collecting in step: each batch stacks theirs, and they get the actor's weights before every batch.
+
+    Ray runs on the cluster `$RAY_ADDRESS` names, else on a local instance of `collectors` CPUs. Each actor
+    asks for one CPU, no GPU and `RAY_COLLECTOR_MEMORY` (TorchRL's defaults ask for a GPU share and 2 GiB).
+    """
+    for spec in env.scenes.specs():
+        spec.load()  # a bad scene name fails here, named, not inside an actor
+    ray_init = ({"address": os.environ["RAY_ADDRESS"]} if os.environ.get("RAY_ADDRESS") else
+                {"address": "local", "num_cpus": config.collectors, "include_dashboard": False})
+    collector = RayCollector(
+        [partial(make_worker_env, env, i, seed + i) for i in range(config.collectors)], actor,
+        frames_per_batch=config.frames_per_batch, total_frames=config.frames - frames_done,
+        init_random_frames=_random_frames(config, frames_done), sync=True, update_after_each_batch=True,
+        ray_init_config={**ray_init, "log_to_driver": False},
+        remote_configs={"num_cpus": RAY_COLLECTOR_CPUS, "num_gpus": 0, "memory": RAY_COLLECTOR_MEMORY},
+        collector_kwargs={"track_traj_ids": False, "auto_register_policy_transforms": False})
+    collector.update_policy_weights_()  # connects the weight sync now; later batches re-send the weights
+    return collector

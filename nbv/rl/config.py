@@ -20,6 +20,7 @@ from tyro.conf import arg
 
 from common.threads import WORKER_THREADS
 from nbv.bov.config import BoVConfig
+from nbv.dist.config import ExecutorConfig
 from render.camera import UAVCamera
 from render.scan import check_camera_distance
 from render.settings import RenderSettings
@@ -142,6 +143,13 @@ class CollectorConfig:
     4 spp, OpenCV SIFT (paper_results/planners)."""
     envs: int = 1
     """Parallel environment workers (spawned processes, one renderer each); 1 runs in-process."""
+    collector: Literal["local", "ray"] = "local"
+    """Where the envs run: local (this process, or --envs spawned workers) or ray (--collectors Ray actors,
+    each building its own env and policy copy, capped to one core; a local Ray instance, or the cluster
+    that $RAY_ADDRESS names). The learner stays in this process."""
+    collectors: int = 2
+    """Ray collectors (--collector ray): actors of one env each, on the cluster's nodes; every batch
+    takes frames_per_batch / collectors steps from each."""
     frames_per_batch: int = 10
     """Environment steps per collected batch (a multiple of --envs)."""
     init_random_frames: int = 100
@@ -162,6 +170,14 @@ class CollectorConfig:
         if self.frames_per_batch < self.envs or self.frames_per_batch % self.envs:
             raise ValueError(f"frames_per_batch ({self.frames_per_batch}) must be a positive multiple of "
                              f"envs ({self.envs})")
+        if self.collectors < 1:
+            raise ValueError(f"collectors must be >= 1, got {self.collectors}")
+        if self.collector == "ray" and self.envs != 1:
+            raise ValueError(f"--collector ray runs one env per collector: give --collectors, not --envs "
+                             f"({self.envs})")
+        if self.collector == "ray" and self.frames_per_batch % self.collectors:
+            raise ValueError(f"frames_per_batch ({self.frames_per_batch}) must be a multiple of collectors "
+                             f"({self.collectors})")
 
 
 @dataclass(frozen=True)
@@ -246,3 +262,6 @@ class TrainConfig:
     """Network sizes."""
     logger: LoggerConfig
     """Logs and checkpoints."""
+    executor: ExecutorConfig = ExecutorConfig()
+    """Where the scenes' view lattices are rendered before training (--lattice): this process, local
+    workers or Ray."""

@@ -8,7 +8,9 @@ keyed by scene content, camera, render settings, lattice, frame size and
 feature settings. During training the env snaps each requested viewpoint to
 the nearest node (azimuth on the circle); evaluation and `nbv plan` render
 exact viewpoints. The snapping error is at most half a step per coordinate:
-`LatticeConfig.max_error`.
+`LatticeConfig.max_error`. Before training, each scene's lattice is a unit of
+work (`lattice_tasks`): `nbv train --workers N` or `--ray` renders them side by
+side, and envs (Ray actors included) then only read the cache.
 """
 
 from __future__ import annotations
@@ -17,18 +19,22 @@ import hashlib
 import json
 import math
 from dataclasses import asdict
+from pathlib import Path
 
 import numpy as np
 import torch
 from tqdm import tqdm
 
 from common.io import atomic_path, cache_dir
+from nbv.dist.task import Task
 from nbv.features.sift import FeatureConfig, extract_features
 from nbv.rl.config import EnvConfig, LatticeConfig
 from render.renderer import MitsubaRenderer
 from render.scan_cache import scene_digest
+from render.variant import select_variant
 from render.viewpoint import TWO_PI, Viewpoint, viewpoint_to_c2w
 from scenes.model import Scene
+from scenes.spec import SceneSpec
 
 CACHE_VERSION = 1
 """Bumped when the cached layout or its meaning changes."""
@@ -90,13 +96,18 @@ def lattice_key(scene: Scene, config: EnvConfig, features: FeatureConfig, varian
     return hashlib.sha1(json.dumps(doc, sort_keys=True).encode()).hexdigest()[:20]
 
 
+def lattice_path(scene: Scene, config: EnvConfig, features: FeatureConfig, variant: str) -> Path:
+    """Where the scene's lattice is cached: `$NBV_CACHE_DIR/lattice/<lattice_key>.pt`."""
+    return cache_dir() / "lattice" / f"{lattice_key(scene, config, features, variant)}.pt"
+
+
 def build_lattice(scene: Scene, renderer: MitsubaRenderer, config: EnvConfig, features: FeatureConfig,
                   progress: bool = True) -> ViewLattice:
     """The scene's lattice, read from the cache or rendered now (node i with render seed i) and cached."""
     from nbv.rl.env import gray_frame
 
     axes = lattice_axes(config)
-    path = cache_dir() / "lattice" / f"{lattice_key(scene, config, features, renderer.variant)}.pt"
+    path = lattice_path(scene, config, features, renderer.variant)
     if path.is_file():
         doc = torch.load(path, weights_only=True)
         return ViewLattice(doc["frames"].numpy(), doc["counts"].numpy(), doc["descriptors"].float(), axes)
@@ -114,3 +125,18 @@ def build_lattice(scene: Scene, renderer: MitsubaRenderer, config: EnvConfig, fe
         torch.save({"frames": stacked, "counts": counts, "descriptors": flat.half()}, tmp)
     return ViewLattice(stacked.numpy(), counts.numpy(), flat.half().float(), axes)
 
+
+def render_lattice(config: EnvConfig, scene: SceneSpec) -> None:
+    """Render one scene's lattice into the cache (a unit of work: `lattice_tasks`)."""
+    loaded = scene.load()
+    build_lattice(loaded, MitsubaRenderer(loaded, config.camera, config.render), config,
+                  config.bov.feature_config(), progress=False)
+
+
+def lattice_tasks(config: EnvConfig) -> list[Task]:
+    """One unit per training scene whose lattice is not cached yet, so an executor renders them side by
+    side before training, instead of every env (or Ray actor) that visits a scene rendering it again."""
+    variant = select_variant(config.render.variant).variant()
+    features = config.bov.feature_config()
+    return [Task(f"view lattice of {spec.scene}", render_lattice, {"config": config, "scene": spec},
+                 lattice_path(spec.load(), config, features, variant)) for spec in config.scenes.specs()]

@@ -14,6 +14,11 @@ start-view RNG, Bag of Views). So a one-worker run stopped and resumed ends
 with the same parameters as one that ran through. With parallel workers the
 workers' episodes in flight are lost at a restart: they start new episodes,
 seeded `seed + frames done`, and everything else resumes exactly.
+
+Across machines, `--collector ray --collectors K` collects on K Ray actors
+(TorchRL's `RayCollector`), each building its own env; the learner, replay
+buffer and checkpoints stay here, and a restart loses the actors' episodes in
+flight as with parallel workers.
 """
 
 from __future__ import annotations
@@ -33,11 +38,13 @@ from tqdm import tqdm
 from common.io import write_json
 from common.provenance import config_from_record, config_record
 from common.threads import set_torch_threads
+from nbv.dist.executor import run_tasks
 from nbv.rl.builders import (
     make_collector,
     make_environment,
     make_loss_module,
     make_optimizers,
+    make_ray_collector,
     make_replay_buffer,
     make_sac_agent,
 )
@@ -53,16 +60,18 @@ from nbv.rl.checkpoint import (
 )
 from nbv.rl.config import TrainConfig
 from nbv.rl.env import NBVEnv
+from nbv.rl.lattice import lattice_tasks
 from nbv.viz.figures import plot_training_curves
 
 CHECKPOINT = "checkpoint.pt"
 POLICY = "policy.pt"
 """The actor and config alone (a few MB, for planning), written beside every checkpoint."""
 RESUMABLE_CHANGES = ("collector.frames", "collector.threads", "logger.out", "logger.checkpoint_every",
-                     "logger.progress")
+                     "logger.progress", "executor.workers", "executor.ray")
 """Settings a resumed run may change, as dotted paths into the nested config record (a difference
 anywhere else, e.g. `env.bov.match_cosine` or `env.camera.width`, is refused). Threads change speed, and
-at most float rounding: runs recorded before the thread policy (threads 0) resume under its default 1."""
+at most float rounding: runs recorded before the thread policy (threads 0) resume under its default 1.
+Where the lattices are rendered changes nothing but speed."""
 CSV_FIELDS = ("frames", "updates", "reward_mean", "episode_return", "episodes", "loss_actor", "loss_qvalue",
               "entropy", "alpha", "collect_s", "update_s")
 
@@ -107,12 +116,21 @@ def train(config: TrainConfig) -> Path:
         if frames >= config.collector.frames:
             return ckpt_path  # the budget is already spent: nothing to do
 
+    # The scenes' view lattices, rendered side by side where the executor says; envs then read the cache.
+    if config.env.lattice.enabled:
+        run_tasks(lattice_tasks(config.env), config.executor)
+
     # Environment and collector (random actions until init_random_frames).
-    envs = config.collector.envs
-    env = make_environment(config.env, envs, seed + frames)
-    if resumed is not None and envs == 1:
-        env.base_env.restore(resumed["env"])
-    collector = make_collector(env, actor, config.collector, frames)
+    in_process = None  # the env whose state checkpoints carry: one in this process
+    if config.collector.collector == "ray":
+        collector = make_ray_collector(config.env, actor, config.collector, seed + frames, frames)
+    else:
+        env = make_environment(config.env, config.collector.envs, seed + frames)
+        if config.collector.envs == 1:
+            in_process = env.base_env
+            if resumed is not None:
+                in_process.restore(resumed["env"])  # before the collector, which resets the env
+        collector = make_collector(env, actor, config.collector, frames)
     if resumed is not None:
         set_rng_state(resumed["rng"])  # after every builder: construction draws random numbers too
 
@@ -164,7 +182,7 @@ def train(config: TrainConfig) -> Path:
                     csv_file.flush()
                     plot_training_curves({run.name: csv_path}, run / "training.png")
                     write_checkpoint(ckpt_path, config, loss_module, optim_actor, optim_critic, buffer,
-                                     frames, updates, env.base_env if envs == 1 else None)
+                                     frames, updates, in_process)
                     last_ckpt = frames
                 start = time.perf_counter()
     finally:

@@ -64,3 +64,20 @@ def test_online_needs_a_policy_and_a_seed(tmp_path, capsys):
         OnlineConfig(out=tmp_path, policies=())
     assert main(["online", "--out", str(tmp_path), "--views", "0"]) == 2
     assert "views must be >= 1" in capsys.readouterr().err
+
+
+def test_online_hands_every_run_of_every_building_to_the_executor_at_once(tmp_path):
+    from nbv.dist.task import unique_tasks
+    from nbv.experiments.compare import comparison_tasks
+    from nbv.experiments.online import comparisons
+
+    config = OnlineConfig(out=tmp_path, scenes=("alpine_chalet", "random:5"), seeds=(0, 1))
+    stages = [comparison_tasks(comparison) for comparison in comparisons(config)]
+    references = unique_tasks([task for refs, _ in stages for task in refs])
+    runs = unique_tasks([task for _, plans in stages for task in plans])
+    # one reference per building (both protocols share it); 4 planners x 2 seeds at 13 views, + one pass
+    assert [task.name for task in references] == ["full-scan reference of alpine_chalet",
+                                                  "full-scan reference of random:5"]
+    assert len(runs) == 2 * (4 * 2 + 2)
+    assert runs[-1].name == f"policy-shipped-seed1 in {tmp_path}/random_5/onepass"
+    assert runs[-1].result == tmp_path / "random_5" / "onepass" / "policy-shipped-seed1" / "plan.json"

@@ -45,3 +45,23 @@ def test_tables_on_a_tiny_grid(tmp_path):
         "fig6_test_building_N2_W5.png",
         "fig6_test_building_N5_W5.png",
     ]
+
+
+def test_tables_on_local_workers_give_the_rows_measured_in_process(tmp_path):
+    from dataclasses import replace
+
+    from nbv.dist.config import ExecutorConfig
+
+    config = TablesConfig(out=tmp_path / "here", scenes=("test_building",), ranges=(3,), words=(5,),
+                          camera=UAVCamera(64, 48), render=RenderSettings(spp=1),
+                          plan=HemispherePlan(end_overlap=0.3, side_overlap=0.2),
+                          recon=ReconstructionConfig(voxel_size_m=0.01, truncation_m=0.04),
+                          metrics=MetricsConfig(n_points=2000))
+    here = run_tables(config)
+    ticks = []
+    workers = replace(config, out=tmp_path / "there", executor=ExecutorConfig(workers=2))
+    there = run_tables(workers, ticks.append)
+    assert there == here and ticks == [2]  # the building's two rows, once it is done
+    docs = [json.loads((tmp_path / out / "table2.json").read_text()) for out in ("here", "there")]
+    assert docs[0]["rows"] == docs[1]["rows"] and "executor" not in docs[1]["config"]
+    assert [p.name for p in (tmp_path / "there" / "fig6").glob("*.png")] == ["fig6_test_building_N3_W5.png"]

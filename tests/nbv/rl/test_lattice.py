@@ -100,3 +100,23 @@ def test_planning_env_renders_exact_viewpoints(tmp_path):
     plan = PlanConfig(scene=SceneSpec(scene="test_building"), planner="policy:x", out=tmp_path)
     env_config = planning_env_config(plan, Trained())
     assert env_config.lattice.enabled is False
+
+
+def test_lattice_units_on_local_workers_cache_what_the_env_renders(tmp_path, monkeypatch):
+    from nbv.dist import ExecutorConfig, run_tasks
+    from nbv.rl.lattice import lattice_tasks
+
+    grid = LatticeConfig(enabled=True, lattice_radii=1, lattice_azimuths=4, lattice_elevations=2)
+    cfg = config(grid, camera=UAVCamera(64, 48), render=RenderSettings(spp=1), obs_size=32,
+                 bov=BoVConfig(ranges=8, features="opencv"))
+    monkeypatch.setenv("NBV_CACHE_DIR", str(tmp_path / "here"))
+    env = NBVEnv(cfg, seed=3)
+    env.reset()  # renders the lattice in this process, into this cache
+    [here] = lattice_tasks(cfg)
+    assert here.done()
+    monkeypatch.setenv("NBV_CACHE_DIR", str(tmp_path / "workers"))  # spawned workers inherit it
+    [unit] = lattice_tasks(cfg)
+    assert not unit.done() and run_tasks([unit], ExecutorConfig(workers=2)) == [unit]
+    assert lattice_tasks(cfg)[0].done()  # (the cache key differs: scene textures live in the cache)
+    a, b = torch.load(here.result, weights_only=True), torch.load(unit.result, weights_only=True)
+    assert all(torch.equal(a[key], b[key]) for key in ("frames", "counts", "descriptors"))

@@ -148,3 +148,23 @@ def test_unknown_scene_is_a_clear_cli_error(tmp_path, capsys):
             "--frames-per-batch", "2", "--out", out, "--no-progress"]
     assert main(args) == 2
     assert "no_such_scene" in capsys.readouterr().err
+
+
+def test_training_on_a_lattice_renders_it_first_on_the_workers(tmp_path, monkeypatch):
+    import nbv.rl.env
+    from nbv.rl.lattice import lattice_path
+
+    monkeypatch.setenv("NBV_CACHE_DIR", str(tmp_path / "cache"))  # spawned workers inherit it
+    original = nbv.rl.env.build_lattice
+
+    def cached_already(scene, renderer, config, features, progress=True):
+        assert lattice_path(scene, config, features, renderer.variant).is_file()  # the env only reads it
+        return original(scene, renderer, config, features, progress)
+
+    monkeypatch.setattr(nbv.rl.env, "build_lattice", cached_already)
+    args = ["train", *TINY_ENV, "--lattice", "--lattice-radii", "1", "--lattice-azimuths", "4",
+            "--lattice-elevations", "2", "--frames", "2", "--frames-per-batch", "2", "--init-random-frames",
+            "2", "--workers", "2", "--out", str(tmp_path / "run"), "--no-progress"]
+    assert main(args) == 0
+    assert len(list((tmp_path / "cache" / "lattice").glob("*.pt"))) == 1
+    assert load_checkpoint(tmp_path / "run" / "checkpoint.pt")["counters"]["frames"] == 2

@@ -36,7 +36,7 @@ COMMANDS = {
     "plot-training": Command("plot_training", "overlay the learning curves of training runs"),
     "demo": Command("demo", "scan, refine, reconstruct and evaluate a built-in scene"),
     "ablate": Command("ablate", "rendering-quality ablations, one axis at a time (make ablations)"),
-    "tables": Command("tables", "reproduce the paper's Table 2 and Fig. 6"),
+    "tables": Command("tables", "the paper's results with seeds: Table 2, Fig. 1, 6, 7, Sec. VII, budgets"),
     "bench": Command("bench", "measure throughput figures (make bench)"),
 }
 """Sub-command name -> where it lives, in `--help` order."""

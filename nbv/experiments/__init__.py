@@ -1,4 +1,5 @@
-"""The paper's experiments: its numbers, the demo, Table 2 and planner comparisons (each a config + a run).
+"""The paper's experiments: its numbers, the demo, its tables and figures, planner comparisons and rendering
+ablations (each a config + a run).
 
 Names are re-exported lazily (`common.lazy`), so importing a config module stays light.
 """
@@ -11,6 +12,12 @@ _EXPORTS = {
     "run_demo": "nbv.experiments.demo",
     "TablesConfig": "nbv.experiments.table2",
     "run_tables": "nbv.experiments.table2",
+    "PaperConfig": "nbv.experiments.paper",
+    "run_paper": "nbv.experiments.paper",
+    "BudgetConfig": "nbv.experiments.budget",
+    "run_budget": "nbv.experiments.budget",
+    "AblateConfig": "nbv.experiments.ablate",
+    "run_ablations": "nbv.experiments.ablate",
     "CompareConfig": "nbv.experiments.compare",
     "compare_planners": "nbv.experiments.compare",
 }

@@ -17,7 +17,8 @@ measures, against the reference render settings (`ablation_axes`):
   at 13 views, its coverage of the true surface.
 Each unit writes its own JSON atomically into a cache folder keyed by the
 settings and the commit, so an interrupted run resumes and a new commit
-measures afresh; `run_ablations` then writes the tables, plots and README
+measures afresh, and runs where `--workers` / `--ray` say (`nbv.dist`);
+`run_ablations` then writes the tables, plots and README
 (`nbv.experiments.ablation_report`) onto `--out` together.
 """
 
@@ -40,6 +41,9 @@ from common.io import atomic_path, cache_dir, write_json
 from common.provenance import git_commit, run_cache
 from common.threads import apply_thread_policy
 from nbv.bov.config import BoVConfig
+from nbv.dist.config import ExecutorConfig
+from nbv.dist.executor import run_tasks
+from nbv.dist.task import Task
 from nbv.experiments.ablation_axes import AXES, REFERENCE, Level, apply_level, check_axes
 from nbv.recon.config import MetricsConfig, ReconstructionConfig
 from render.camera import UAVCamera
@@ -95,6 +99,8 @@ class AblateConfig(MeshOrientation):
     `make ablations` within the hour)."""
     quick: bool = False
     """A small run (one building, one seed, a small camera and scan): the defaults of `QUICK`."""
+    executor: ExecutorConfig = ExecutorConfig()
+    """Where the units run: this process, local workers or Ray (render times are then per worker)."""
 
     def __post_init__(self) -> None:
         check_axes(self.axes)
@@ -299,12 +305,15 @@ def run_ablations(config: AblateConfig, progress: Progress | None = None) -> lis
     `config.out`; returns the units' documents."""
     from nbv.experiments.ablation_report import write_report
 
-    folder = run_cache("ablations", config, unkeyed=("out", "axis", "scene", "seeds"))
+    folder = run_cache("ablations", config, unkeyed=("out", "axis", "scene", "seeds", "executor"))
     start = time.perf_counter()
-    docs = []
-    for unit in units(config):
-        docs.append(measure_unit(config, unit, folder))
-        if progress is not None:
-            progress(1)
+    todo = units(config)
+    tasks = [Task(unit.name, measure_unit, {"config": config, "unit": unit, "folder": folder},
+                  unit_path(folder, unit)) for unit in todo]
+    skipped = sum(task.done() for task in tasks)
+    if progress is not None and skipped:
+        progress(skipped)
+    run_tasks(tasks, config.executor, None if progress is None else lambda task: progress(1))
+    docs = [json.loads(unit_path(folder, unit).read_text()) for unit in todo]
     write_report(config, docs, folder, time.perf_counter() - start)
     return docs

@@ -22,9 +22,12 @@ from __future__ import annotations
 
 import json
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
+
+import numpy as np
+from tyro.conf import Suppress
 
 from common.io import atomic_folder, markdown_table, scratch_folder, write_json, write_text
 from common.provenance import config_record, git_commit
@@ -67,6 +70,15 @@ class TablesConfig(FullScanStudy):
     executor: ExecutorConfig = ExecutorConfig()
     """Where the buildings are measured: this process, local workers or Ray (not recorded: it changes no
     number)."""
+    seeds: tuple[int, ...] = (0, 1, 2)
+    """Seeds of the renders, the Bag of Views and the metric samples: each gives its own full scans and
+    grid; tables give the mean and std over them (Fig. 6 shows the first)."""
+    seed: Suppress[int] = 0
+    """The seed being measured (set from `seeds`)."""
+
+    def __post_init__(self) -> None:
+        if not self.seeds or min(self.seeds) < 0:
+            raise ValueError(f"tables need at least one seed, each >= 0, got {self.seeds}")
 
 
 def paper_cell(scene: str, n: int, w: int) -> dict[str, Any]:
@@ -88,7 +100,7 @@ def measure_scene(name: str, config: TablesConfig, progress: Progress | None = N
                   fig6: Path | None = None) -> list[dict[str, Any]]:
     """Table 2 rows of one building: the full scan against ground truth, then one row per (N, W).
 
-    Writes the Fig. 6 heat maps of the grid's corner cells into `fig6` (default `config.out/fig6`).
+    Writes the Fig. 6 heat maps of the grid's corner cells into `fig6` (None: none).
     `progress` is called once per row measured.
     """
     scene = config.load(name)
@@ -100,32 +112,33 @@ def measure_scene(name: str, config: TablesConfig, progress: Progress | None = N
     reference = reconstruct_dataset(full, config.recon).mesh
     gt = scene.target_mesh()
     full_vs_gt = evaluate_surfaces(reference, {"gt": gt}, metrics)["gt"]
-    rows = [{"scene": name, "ranges": "-", "words": "-", "views": len(full), "paper_views": FULL_SCAN_VIEWS,
+    rows = [{"scene": name, "seed": config.seed, "ranges": "-", "words": "-", "views": len(full),
+             "paper_views": FULL_SCAN_VIEWS,
              **_prefixed("gt", full_vs_gt.as_dict())}]
     _tick(progress)
     for (n, w), result in grid.items():
         recon = reconstruct_dataset(full, config.recon, result.kept).mesh
         m = evaluate_surfaces(recon, {"reference": reference, "gt": gt}, metrics)
         paper = paper_cell(name, n, w)
-        rows.append({"scene": name, "ranges": n, "words": w, "views": len(result.kept),
+        rows.append({"scene": name, "seed": config.seed, "ranges": n, "words": w, "views": len(result.kept),
                      "paper_views": paper.get("views"), **_prefixed("ref", m["reference"].as_dict()),
                      "paper_hausdorff_cm": paper.get("hausdorff_cm"),
                      "paper_chamfer_cm": paper.get("chamfer_cm"), **_prefixed("gt", m["gt"].as_dict())})
-        if (n, w) in _corners(config):
+        if fig6 is not None and (n, w) in _corners(config):
             title = f"{name}: N={n}, W={w}, {len(result.kept)} views vs the {len(full)}-view scan"
-            write_heatmap(recon, reference, Path(config.out) / "fig6" if fig6 is None else fig6,
-                          name=f"fig6_{name}_N{n}_W{w}", title=title)
+            write_heatmap(recon, reference, fig6, name=f"fig6_{name}_N{n}_W{w}", title=title)
         _tick(progress)
     return rows
 
 
-def measure_scene_unit(name: str, config: TablesConfig, folder: Path,
-                       progress: Progress | None = None) -> None:
-    """`measure_scene` as a unit of work: `folder/rows.json` and the heat maps in `folder/fig6/`, written
-    together (`common.io.atomic_folder`)."""
+def measure_scene_unit(name: str, config: TablesConfig, folder: Path, progress: Progress | None = None,
+                       heatmaps: bool = True) -> None:
+    """`measure_scene` as a unit of work: `folder/rows.json` and (with `heatmaps`) the heat maps in
+    `folder/fig6/`, written together (`common.io.atomic_folder`)."""
     with atomic_folder(folder, overwrite=True) as tmp:
         (tmp / "fig6").mkdir()
-        write_text(tmp / "rows.json", json.dumps(measure_scene(name, config, progress, tmp / "fig6")))
+        rows = measure_scene(name, config, progress, tmp / "fig6" if heatmaps else None)
+        write_text(tmp / "rows.json", json.dumps(rows))
 
 
 def _tick(progress: Progress | None) -> None:
@@ -139,27 +152,31 @@ def _prefixed(prefix: str, metrics: dict[str, float]) -> dict[str, float]:
 
 
 def run_tables(config: TablesConfig, progress: Progress | None = None) -> list[dict[str, Any]]:
-    """Measure every scene and write `table2.csv`, `table2.md`, `table2.json` and `table2.png`.
+    """Measure every scene at every seed and write `table2.csv`, `table2.md`, `table2.json` (the rows:
+    mean and std over seeds; and every seed's rows), `table2.png` and `fig6/` (the first seed's).
 
-    `progress` is called once per row measured: 1 + len(ranges) * len(words) per scene.
+    `progress` is called once per row measured: 1 + len(ranges) * len(words) per scene and seed.
     """
     out = Path(config.out)
     start = time.perf_counter()
     with scratch_folder(out) as work:
         # In this process the rows tick one by one; elsewhere a building's rows tick when it is done.
         here = config.executor.ray is None and config.executor.workers == 1
-        units = [Task(f"Table 2 rows of {name} (scene {i})", measure_scene_unit,
-                      {"name": name, "config": config, "folder": work / f"scene{i}",
-                       "progress": progress if here else None}, work / f"scene{i}" / "rows.json")
-                 for i, name in enumerate(config.scenes)]
+        units = [Task(f"Table 2 rows of {name} (scene {i}, seed {seed})", measure_scene_unit,
+                      {"name": name, "config": replace(config, seed=seed),
+                       "folder": work / f"seed{seed}-scene{i}", "progress": progress if here else None,
+                       "heatmaps": seed == config.seeds[0]},
+                      work / f"seed{seed}-scene{i}" / "rows.json")
+                 for seed in config.seeds for i, name in enumerate(config.scenes)]
         per_scene = 1 + len(config.ranges) * len(config.words)
         run_tasks(units, config.executor, None if here or progress is None else lambda _: progress(per_scene))
-        rows, fig6 = [], work / "fig6"
+        seed_rows, fig6 = [], work / "fig6"
         fig6.mkdir()
         for unit in units:
-            rows += json.loads(unit.result.read_text())
+            seed_rows += json.loads(unit.result.read_text())
             for image in sorted((unit.result.parent / "fig6").iterdir()):
                 image.rename(fig6 / image.name)
+        rows = mean_rows(seed_rows)
         record = config_record(config)
         del record["executor"]
         header = {"command": f"make tables  (nbv tables --out {out})", "commit": git_commit(),
@@ -169,20 +186,58 @@ def run_tables(config: TablesConfig, progress: Progress | None = None) -> list[d
             write_csv(folder / "table2.csv", rows, fieldnames=list(rows[-1]))
             write_text(folder / "table2.md", table2_markdown(rows, header))
             plot_table2(rows, folder / "table2.png")
-            write_json(folder / "table2.json", {**header, "rows": rows})
+            write_json(folder / "table2.json", {**header, "rows": rows, "seed_rows": seed_rows})
+    return rows
+
+
+MEASURED = ("views", "ref_hausdorff_cm", "ref_chamfer_cm", "gt_chamfer_cm", "gt_hausdorff_cm", "gt_coverage",
+            "gt_fscore")
+"""Row keys measured per seed: averaged over seeds, with their std beside them (`<key>_std`)."""
+
+
+def mean_rows(seed_rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """One row per building and cell, in first-seen order: each measured key's mean over seeds and its
+    population std (`<key>_std`); other keys from the first seed's row, `seeds` the seeds.
+
+    Example:
+        >>> rows = mean_rows([{"scene": "a", "seed": 0, "ranges": 5, "words": 10, "views": 10},
+        ...                   {"scene": "a", "seed": 1, "ranges": 5, "words": 10, "views": 14}])
+        >>> rows[0]["views"], rows[0]["views_std"], rows[0]["seeds"]
+        (12.0, 2.0, [0, 1])
+    """
+    groups: dict[tuple, list[dict[str, Any]]] = {}
+    for row in seed_rows:
+        groups.setdefault((row["scene"], row["ranges"], row["words"]), []).append(row)
+    rows = []
+    for group in groups.values():
+        row = {k: v for k, v in group[0].items() if k != "seed"}
+        row["seeds"] = [r.get("seed") for r in group]
+        for key in MEASURED:
+            values = [r[key] for r in group if r.get(key) is not None]
+            if values:
+                row[key] = round(float(np.mean(values)), 4)
+                row[f"{key}_std"] = round(float(np.std(values)), 4)
+        rows.append(row)
     return rows
 
 
 def table2_markdown(rows: list[dict[str, Any]], header: dict[str, Any]) -> str:
     """Table 2 as Markdown: ours beside the paper's, per building and (N, W)."""
-    def show(value: Any) -> str:
-        return "-" if value is None else (f"{value:.4g}" if isinstance(value, float) else str(value))
+    def show(row: dict[str, Any], key: str) -> str:
+        value = row.get(key)
+        if value is None:
+            return "-"
+        text = f"{value:.4g}" if isinstance(value, float) else str(value)
+        spread = row.get(f"{key}_std")
+        return f"{text} ± {spread:.2g}" if spread is not None and len(row.get("seeds", [])) > 1 else text
 
+    seeds = ", ".join(map(str, header["config"]["seeds"]))
     intro = (f"Measured by `{header['command']}` at commit {header['commit']} in {header['seconds']} s; "
-             "settings in `table2.json`. 'paper' columns are the paper's own numbers (Hatami Gazani et al. "
+             f"mean ± std over seeds {seeds} (renders, Bag of Views and metric samples); settings in "
+             "`table2.json`. 'paper' columns are the paper's own numbers (Hatami Gazani et al. "
              "2023, Table 2); distances are in cm against the TSDF reconstruction of the full 288-view scan "
              "('ref', as in the paper) and against the ground-truth mesh ('gt', which the paper did not "
              "have).")
     table = markdown_table(["building", *COLUMNS.values()],
-                           [[r["scene"], *(show(r.get(k)) for k in COLUMNS)] for r in rows])
+                           [[r["scene"], *(show(r, k) for k in COLUMNS)] for r in rows])
     return f"# Table 2: Bag of Views size vs kept views and reconstruction error\n\n{intro}\n\n{table}"

@@ -318,9 +318,10 @@ def test_tables_interrupted_keeps_the_previous_tables_and_fig6(tmp_path, monkeyp
     grid = {"n": 5}
 
     def measure(name, config, progress=None, fig6=None):
-        Path(fig6).mkdir(exist_ok=True)
-        (Path(fig6) / f"fig6_{name}_N{grid['n']}.png").write_bytes(b"png")
-        return [{"scene": name, "ranges": grid["n"], "words": 10, "views": 3}]
+        if fig6 is not None:  # the first seed's heat maps
+            Path(fig6).mkdir(exist_ok=True)
+            (Path(fig6) / f"fig6_{name}_N{grid['n']}.png").write_bytes(b"png")
+        return [{"scene": name, "seed": config.seed, "ranges": grid["n"], "words": 10, "views": 3}]
 
     monkeypatch.setattr("nbv.experiments.table2.measure_scene", measure)
     monkeypatch.setattr("nbv.experiments.table2.plot_table2",

@@ -31,6 +31,7 @@ def test_tables_on_a_tiny_grid(tmp_path):
         plan=HemispherePlan(end_overlap=0.5, side_overlap=0.4),
         recon=ReconstructionConfig(voxel_size_m=0.01, truncation_m=0.04),
         metrics=MetricsConfig(n_points=3000),
+        seeds=(0, 1),
     )
     rows = run_tables(config)
     assert [(r["ranges"], r["words"]) for r in rows] == [("-", "-"), (2, 5), (5, 5)]
@@ -39,6 +40,12 @@ def test_tables_on_a_tiny_grid(tmp_path):
         assert len(list(csv.DictReader(handle))) == 3
     doc = json.loads((tmp_path / "table2.json").read_text())
     assert doc["config"]["ranges"] == [2, 5] and doc["commit"]
+    assert [r["seed"] for r in doc["seed_rows"]] == [0, 0, 0, 1, 1, 1]  # each seed renders its own scan
+    for row in rows:  # the mean and std over the two seeds' rows of the cell
+        cell = (row["ranges"], row["words"])
+        mine = [r["views"] for r in doc["seed_rows"] if (r["ranges"], r["words"]) == cell]
+        assert row["views"] == sum(mine) / 2 and row["views_std"] == abs(mine[0] - mine[1]) / 2
+        assert row["seeds"] == [0, 1]
     assert "| test_building | 2 | 5 |" in (tmp_path / "table2.md").read_text()
     assert (tmp_path / "table2.png").stat().st_size > 0
     assert sorted(p.name for p in (tmp_path / "fig6").glob("*.png")) == [

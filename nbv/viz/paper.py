@@ -1,0 +1,56 @@
+"""Pictures of `make tables` beyond Table 2: coverage against view budget, and the one-pass episodes."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from matplotlib.figure import Figure
+
+from nbv.viz.figures import save_figure
+
+
+def plot_budget_curves(rows: dict[str, Sequence[dict[str, Any]]], budgets: Sequence[int],
+                       out: str | Path) -> Path:
+    """Each measure (a row of panels: reconstructed, then visible coverage %) against views for every
+    planner (error bars: one std over seeds), a panel per building and one for the mean over buildings;
+    each legend entry gives the curve's AUC."""
+    measures = list(rows)
+    scenes = list(dict.fromkeys(r["scene"] for r in rows[measures[0]]))
+    fig = Figure(figsize=(4.6 * len(scenes), 4.2 * len(measures)))
+    axes = fig.subplots(len(measures), len(scenes), squeeze=False)
+    for line, measure in zip(axes, measures):
+        for ax, scene in zip(line, scenes):
+            for i, row in enumerate(r for r in rows[measure] if r["scene"] == scene):
+                dashed = "--" if row["planner"] == "oracle" else "-"
+                ax.errorbar(budgets, row["mean"], yerr=row["std"], marker="o", capsize=3, linestyle=dashed,
+                            color=f"C{i % 10}", label=f"{row['planner']} (AUC {row['auc']:.1f})")
+            ax.set(xlabel="views", ylabel=f"{measure} % of the true surface", title=scene,
+                   xticks=list(budgets))
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=7)
+    fig.suptitle("Coverage against view budget (oracle dashed: an upper bound)")
+    return save_figure(fig, out)
+
+
+def plot_episodes(rows: Sequence[dict[str, Any]], out: str | Path) -> Path:
+    """Bars of our one-pass episodes per building (mean ± std over seeds) for Hausdorff, Chamfer and
+    coverage against the full scan, the paper's value as a red marker where it gives one."""
+    panels = (("ref_hausdorff_cm", "hausdorff_cm", 1.0, "Hausdorff cm (vs full scan)"),
+              ("ref_chamfer_cm", "chamfer_cm", 1.0, "Chamfer cm (vs full scan)"),
+              ("ref_coverage", "coverage", 100.0, "coverage % (vs full scan)"))
+    fig = Figure(figsize=(4.4 * len(panels), 4.2))
+    axes = fig.subplots(1, len(panels))
+    x = list(range(len(rows)))
+    for ax, (key, paper_key, scale, title) in zip(axes, panels):
+        ax.bar(x, [r[key] for r in rows], yerr=[r[f"{key}_std"] for r in rows], capsize=4, color="tab:blue",
+               label="ours")
+        marked = [(i, scale * r["paper"][paper_key]) for i, r in enumerate(rows) if paper_key in r["paper"]]
+        if marked:
+            ax.plot(*zip(*marked), "D", color="tab:red", label="paper")
+        ax.set_xticks(x, [f"{r['scene']}\n{r['role']}" for r in rows], fontsize=7)
+        ax.set_title(title, fontsize=10)
+        ax.legend(fontsize=8)
+    fig.suptitle("Fig. 1 and Fig. 7: one pass around the target")
+    return save_figure(fig, out)

@@ -23,8 +23,8 @@ NODES = (1, 2, 4, 8)
 CORES = (2, 16, 64)
 ABLATION_BUILDINGS, ABLATION_SEEDS = 2, 3
 """`nbv ablate`'s default run: the two Table 2 buildings, seeds 0 1 2."""
-ABLATION_LEVELS, ABLATION_LIGHTING_LEVELS = 30, 6
-"""Units per building and seed of `nbv ablate`'s default run: the reference and 29 levels of 13 axes; the
+ABLATION_LEVELS, ABLATION_LIGHTING_LEVELS = 29, 6
+"""Units per building and seed of `nbv ablate`'s default run: the reference and 28 levels of 13 axes; the
 lighting ones (and the reference) also plan greedily."""
 
 
@@ -108,10 +108,10 @@ def costs_table(args: argparse.Namespace) -> str:
         ["one Table 2 building (288-view scan, features, the N x W grid, 12 reconstructions, metrics)",
          "`seconds` / buildings", f"`{args.table2}` (`make tables` in one process on 2 cores: on one core "
                                   "it may take up to 2x)"],
-        ["one ablation level (34-view scan at 160x120, quality views, refinement, fusion)",
+        ["one ablation level (25-view scan at 160x120, quality views, refinement, fusion)",
          f"{args.ablation_s:g}; {args.ablation_lighting_s:g} when it also plans greedily (lighting levels "
-         "and the reference)", "the spacing of consecutive unit files of an `nbv ablate` run on "
-                               "medieval_tavern at its default settings"]])
+         "and the reference)", "mean spacing of consecutive unit files of `make ablations` at "
+                               "ee541ca (both buildings, 2 cores, one process; paper_results/ablations)"]])
 
 
 def planning_ranges(path: str) -> str:
@@ -179,8 +179,8 @@ def main() -> None:
                         help="core seconds of a plan run whose planning takes no time (random planner)")
     parser.add_argument("--reference-s", type=float, required=True,
                         help="core seconds of a building's full-scan reference")
-    parser.add_argument("--ablation-s", type=float, default=13.0, help="core seconds of an ablation level")
-    parser.add_argument("--ablation-lighting-s", type=float, default=68.0,
+    parser.add_argument("--ablation-s", type=float, default=9.4, help="core seconds of an ablation level")
+    parser.add_argument("--ablation-lighting-s", type=float, default=31.6,
                         help="core seconds of an ablation level that also plans greedily")
     parser.add_argument("--startup-s", type=float, default=20.0, help="start-up seconds paid once per run")
     parser.add_argument("--efficiency", type=float, default=1.0, help="parallel efficiency per core, (0, 1]")

@@ -60,10 +60,15 @@ def _value(tp: Any, value: Any) -> Any:
     return value
 
 
+RESULTS = "paper_results"
+"""Where committed results live: their own changes (a run writing them) do not make the code dirty."""
+
+
 def git_commit() -> str:
-    """Short hash of the checked-out commit (with '+dirty' for uncommitted changes), or 'unknown'."""
+    """Short hash of the checked-out commit (with '+dirty' for uncommitted changes to tracked files outside
+    `RESULTS`), or 'unknown'."""
     try:
-        dirty = "+dirty" if _git("status", "--porcelain", "-uno") else ""
+        dirty = "+dirty" if _git("status", "--porcelain", "-uno", "--", ".", f":(exclude){RESULTS}") else ""
         return _git("rev-parse", "--short", "HEAD") + dirty
     except (OSError, subprocess.CalledProcessError):
         return "unknown"

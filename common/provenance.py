@@ -18,9 +18,11 @@ def _git(*args: str) -> str:
     return subprocess.run(["git", *args], capture_output=True, text=True, check=True).stdout.strip()
 
 
-def config_record(config: Any) -> dict:
-    """A config dataclass as JSON-compatible nested dicts (tuples as lists, paths as strings)."""
-    return json.loads(json.dumps(dataclasses.asdict(config), default=str))
+def config_record(config: Any, omit: tuple[str, ...] = ()) -> dict:
+    """A config dataclass as JSON-compatible nested dicts (tuples as lists, paths as strings), without its
+    top-level fields `omit` (e.g. `executor`, which changes no number)."""
+    record = json.loads(json.dumps(dataclasses.asdict(config), default=str))
+    return {k: v for k, v in record.items() if k not in omit}
 
 
 def config_from_record(cls: type[T], record: dict) -> T:
@@ -80,6 +82,6 @@ def run_cache(kind: str, config: Any, unkeyed: tuple[str, ...] = ()) -> Path:
     resumes and a run at another commit measures afresh."""
     from common.io import cache_dir
 
-    record = {k: v for k, v in config_record(config).items() if k not in unkeyed}
-    key = hashlib.sha1(json.dumps([record, git_commit()], sort_keys=True, default=str).encode()).hexdigest()
+    record = [config_record(config, unkeyed), git_commit()]
+    key = hashlib.sha1(json.dumps(record, sort_keys=True, default=str).encode()).hexdigest()
     return cache_dir() / kind / key[:16]

@@ -160,7 +160,7 @@ def write_report(config: Any, docs: list[dict[str, Any]], folder: Path, seconds:
     rows = summary_rows(docs, config.axes)
     header = {"command": rerun_command(config).replace("DIR", str(config.out)), "commit": git_commit(),
               "seconds": round(seconds, 1), "units": len(docs), "scan_views": docs[0]["scan_views"],
-              "config": {k: v for k, v in config_record(config).items() if k != "executor"}}
+              "config": config_record(config, omit=("executor",))}
     outputs = OUTPUTS + tuple(f"axis_{name}.png" for name in AXES)
     with atomic_folder(config.out, overwrite=True, outputs=outputs) as out:
         write_csv(out / "ablations.csv", rows, fieldnames=list(rows[0]))

@@ -180,8 +180,7 @@ def run_budget(config: BudgetConfig) -> dict[str, list[dict[str, Any]]]:
                         for scene in config.scenes for p in config.planners}
               for measure, _ in MEASURES}
     rows = {measure: budget_rows(curves[measure], config.budgets) for measure, _ in MEASURES}
-    record = config_record(config)
-    del record["executor"]
+    record = config_record(config, omit=("executor",))
     with atomic_folder(config.out, overwrite=True, outputs=OUTPUTS) as out:
         write_text(out / "budget.md", budget_markdown(rows, config))
         plot_budget_curves(rows, config.budgets, out / "budget.png")

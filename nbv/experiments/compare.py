@@ -112,8 +112,7 @@ def compare_planners(config: CompareConfig) -> str:
                          **{k: doc[k] for k in ("views", "gt", "reference", "planning_s", "deciding_s")}})
     scene = config.scene.scene
     table = comparison_table(runs, scene, config.metrics.threshold_cm)
-    record = config_record(config)
-    del record["executor"]
+    record = config_record(config, omit=("executor",))
     with atomic_folder(out, overwrite=True, outputs=OUTPUTS) as folder:
         write_text(folder / "comparison.md", table)
         plot_planner_comparison(runs, FIG1_NBV, folder / "comparison.png",

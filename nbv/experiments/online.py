@@ -111,8 +111,7 @@ def run_online(config: OnlineConfig) -> str:
     text = online_report(budget, one_pass, policy, config)
     coverage = {label: [np.mean(_values(runs[label], "gt", "coverage")) * 100 for runs in budget.values()]
                 for label in next(iter(budget.values()))}
-    record = config_record(config)
-    del record["executor"]
+    record = config_record(config, omit=("executor",))
     with atomic_folder(out, overwrite=True, outputs=OUTPUTS) as folder:
         write_text(folder / "online.md", text)
         plot_seed_scores(coverage, folder / "online.png",

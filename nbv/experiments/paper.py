@@ -151,8 +151,7 @@ def run_episodes(config: PaperConfig) -> list[dict[str, Any]]:
     with atomic_folder(config.out, overwrite=True, outputs=EPISODE_OUTPUTS) as out:
         write_text(out / "fig1_fig7.md", episodes_markdown(rows, config))
         plot_episodes(rows, out / "fig1_fig7.png")
-        record = config_record(config)
-        del record["executor"]
+        record = config_record(config, omit=("executor",))
         write_json(out / "fig1_fig7.json", {"commit": git_commit(), "config": record, "rows": rows})
     return rows
 

@@ -177,8 +177,7 @@ def run_tables(config: TablesConfig, progress: Progress | None = None) -> list[d
             for image in sorted((unit.result.parent / "fig6").iterdir()):
                 image.rename(fig6 / image.name)
         rows = mean_rows(seed_rows)
-        record = config_record(config)
-        del record["executor"]
+        record = config_record(config, omit=("executor",))
         header = {"command": f"make tables  (nbv tables --out {out})", "commit": git_commit(),
                   "seconds": round(time.perf_counter() - start, 1), "config": record}
         with atomic_folder(out, overwrite=True, outputs=OUTPUTS) as folder:

@@ -33,8 +33,6 @@ import math
 from pathlib import Path
 
 import numpy as np
-import torch
-from torchrl.envs.utils import ExplorationType, set_exploration_type
 
 from common.provenance import config_from_record
 from nbv.planning.base import Planner, check_candidates, sample_viewpoints
@@ -45,6 +43,7 @@ from nbv.rl.agent import make_actor
 from nbv.rl.checkpoint import CheckpointError, load_policy
 from nbv.rl.config import EnvConfig, NetworkConfig
 from nbv.rl.env import NBVEnv
+from nbv.rl.rollout import policy_views
 from render.scan import HemispherePlan, hemisphere_scan
 from render.viewpoint import TWO_PI, Viewpoint
 
@@ -150,19 +149,7 @@ class PolicyPlanner(Planner):
     def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
         """Act until the episode ends (one pass or the step cap), or for exactly `views` views."""
         self.check_env(env)
-        td = env.reset()
-        chosen = [env.viewpoint]
-        exploration = ExplorationType.RANDOM if self.sample else ExplorationType.DETERMINISTIC
-        with torch.no_grad(), set_exploration_type(exploration), torch.random.fork_rng():
-            torch.manual_seed(self.seed)
-            while len(chosen) < (math.inf if views is None else views):
-                td = env.step(self.actor(td))
-                chosen.append(env.viewpoint)
-                done = bool(td["next", "done"])
-                td = td["next"]
-                if views is None and done:
-                    break
-        return chosen
+        return policy_views(self.actor, env, views, self.sample, self.seed)
 
 
 POLICY_KINDS = ("policy", "policy-sample")

@@ -97,8 +97,13 @@ def load_checkpoint(path: str | Path, kinds: tuple[str, ...] = (FORMAT,)) -> dic
 
 def save_policy(path: str | Path, config: str, loss_state: dict[str, Any], counters: dict[str, int]) -> Path:
     """Write a policy file: the run config (JSON text), the actor weights out of the loss state, counters."""
-    actor = {k[len(ACTOR_PREFIX):]: v for k, v in loss_state.items() if k.startswith(ACTOR_PREFIX)}
-    return save_checkpoint(path, {"config": config, "actor": actor, "counters": counters}, POLICY_FORMAT)
+    return save_checkpoint(path, {"config": config, "actor": actor_weights(loss_state), "counters": counters},
+                           POLICY_FORMAT)
+
+
+def actor_weights(loss_state: dict[str, Any]) -> dict[str, torch.Tensor]:
+    """The actor's state dict out of a SAC loss module's state dict."""
+    return {k[len(ACTOR_PREFIX):]: v for k, v in loss_state.items() if k.startswith(ACTOR_PREFIX)}
 
 
 def load_policy(path: str | Path) -> tuple[dict[str, Any], dict[str, torch.Tensor]]:
@@ -109,8 +114,7 @@ def load_policy(path: str | Path) -> tuple[dict[str, Any], dict[str, torch.Tenso
         weights = state["actor"]
     else:
         loss = state["loss"]
-        weights = {k[len(ACTOR_PREFIX):]: v for k, v in loss.items() if k.startswith(ACTOR_PREFIX)} \
-            if isinstance(loss, dict) else loss
+        weights = actor_weights(loss) if isinstance(loss, dict) else loss
     return config, weights
 
 

@@ -233,6 +233,34 @@ class OptimConfig:
             raise ValueError(f"target_update_interval must be >= 1, got {self.target_update_interval}")
 
 
+@dataclass(frozen=True)
+class ValidationConfig:
+    """Checkpoint selection on validation buildings (beyond the paper): at every checkpoint the policy's mode
+    flies `validation_views` views from `validation_episodes` seeded start views on each validation building's
+    view lattice, scored by the visible coverage of the true surface (`nbv.rl.validate`); `policy.pt` keeps
+    the best-scoring actor instead of the last. Off when no building is given."""
+
+    validation_scenes: tuple[str, ...] = ()
+    """Validation buildings (never training or test buildings); none: no validation, `policy.pt` is the
+    last actor."""
+    validation_episodes: int = 3
+    """Start views per validation building (seeds 0 .. N-1, the same at every checkpoint)."""
+    validation_views: int = 13
+    """Views per validation episode, the start view included."""
+    validation_points: int = 20_000
+    """True-surface samples of the coverage score per building."""
+
+    def __post_init__(self) -> None:
+        for name in ("validation_episodes", "validation_views", "validation_points"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
+
+    @property
+    def enabled(self) -> bool:
+        """Whether checkpoints are scored on validation buildings."""
+        return bool(self.validation_scenes)
+
+
 @dataclass(frozen=True, kw_only=True)
 class LoggerConfig:
     """Run folder, logs and checkpoints."""
@@ -241,7 +269,8 @@ class LoggerConfig:
     """Run folder (checkpoint.pt, metrics.csv, training.png, tensorboard/, config.json); resumes its
     checkpoint if any."""
     checkpoint_every: int = 500
-    """Environment steps between checkpoints (one is always written at the end)."""
+    """Environment steps between checkpoints (one is always written at the end); each is validated when
+    validation buildings are given."""
     progress: bool = True
     """Show a progress bar."""
 
@@ -262,6 +291,8 @@ class TrainConfig:
     """Network sizes."""
     logger: LoggerConfig
     """Logs and checkpoints."""
+    validation: ValidationConfig = ValidationConfig()
+    """Checkpoint selection on validation buildings (off by default; on in the `default` preset)."""
     executor: ExecutorConfig = ExecutorConfig()
     """Where the scenes' view lattices are rendered before training (--lattice): this process, local
     workers or Ray."""

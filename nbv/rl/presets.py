@@ -19,7 +19,15 @@ from dataclasses import replace
 import tyro
 
 from nbv.bov.config import BoVConfig
-from nbv.rl.config import CollectorConfig, EnvConfig, LatticeConfig, LoggerConfig, OptimConfig, TrainConfig
+from nbv.rl.config import (
+    CollectorConfig,
+    EnvConfig,
+    LatticeConfig,
+    LoggerConfig,
+    OptimConfig,
+    TrainConfig,
+    ValidationConfig,
+)
 from render.camera import UAVCamera
 from render.settings import RenderSettings
 from scenes.spec import SceneSet
@@ -27,6 +35,10 @@ from scenes.spec import SceneSet
 TRAIN_SCENES = ("medieval_tavern", "forest_ruin_house", "random:1", "random:2", "random:3", "random:4")
 """The generalist's training buildings: both training presets and four training-split random buildings
 (held out: alpine_chalet, imperial_temple and random:SEED with SEED % 5 == 0)."""
+FRAMES = 8000
+"""The default preset's budget."""
+VALIDATION_SCENES = ("random:6", "random:7", "random:8")
+"""Training-split buildings no run trains on: candidates and checkpoints are chosen on these."""
 
 
 def paper_preset() -> TrainConfig:
@@ -41,8 +53,9 @@ def default_preset() -> TrainConfig:
     env = replace(paper.env, camera=UAVCamera(160, 120), render=RenderSettings(spp=4),
                   bov=BoVConfig(ranges=8, features="opencv", elevation_bands=2),
                   lattice=LatticeConfig(enabled=True), action_mode="relative", relative_step=0.125)
-    return replace(paper, env=env, collector=CollectorConfig(frames=4000),
-                   optim=OptimConfig(reward_scale=0.1))
+    return replace(paper, env=env, collector=CollectorConfig(frames=FRAMES),
+                   optim=OptimConfig(reward_scale=0.1), logger=replace(paper.logger, checkpoint_every=250),
+                   validation=ValidationConfig(validation_scenes=VALIDATION_SCENES))
 
 
 PRESETS = {"default": default_preset, "paper": paper_preset}

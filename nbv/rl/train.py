@@ -4,7 +4,9 @@ The loop, top to bottom: build env, networks, loss, optimisers, buffer;
 restore the run folder's checkpoint if there is one; then collect a batch,
 store it, take gradient steps (soft-updating the target critics every
 `target_update_interval` steps), log, and checkpoint (with `training.png`,
-the learning curves so far).
+the learning curves so far). With validation buildings, each checkpoint's
+actor is first scored on them (`nbv.rl.validate`, `validation.csv`) and
+`policy.pt` keeps the best one.
 
 Exact resumption: checkpoints are taken between iterations and hold
 everything the rest of the run depends on: networks, optimisers, replay
@@ -49,6 +51,7 @@ from nbv.rl.builders import (
     make_sac_agent,
 )
 from nbv.rl.checkpoint import (
+    actor_weights,
     check_compatible,
     checkpoint_config,
     load_checkpoint,
@@ -61,11 +64,15 @@ from nbv.rl.checkpoint import (
 from nbv.rl.config import TrainConfig
 from nbv.rl.env import NBVEnv
 from nbv.rl.lattice import lattice_tasks
+from nbv.rl.validate import LatticeValidator, validation_env_config
 from nbv.viz.figures import plot_training_curves
 
 CHECKPOINT = "checkpoint.pt"
 POLICY = "policy.pt"
-"""The actor and config alone (a few MB, for planning), written beside every checkpoint."""
+"""The actor and config alone (a few MB, for planning), written beside every checkpoint; with validation
+buildings, only when the checkpoint's actor scores best on them so far."""
+VALIDATION_CSV = "validation.csv"
+"""One row per validated checkpoint: frames, the score (%) per validation building, their mean, the best."""
 RESUMABLE_CHANGES = ("collector.frames", "collector.threads", "logger.out", "logger.checkpoint_every",
                      "logger.progress", "executor.workers", "executor.ray")
 """Settings a resumed run may change, as dotted paths into the nested config record (a difference
@@ -117,8 +124,15 @@ def train(config: TrainConfig) -> Path:
             return ckpt_path  # the budget is already spent: nothing to do
 
     # The scenes' view lattices, rendered side by side where the executor says; envs then read the cache.
-    if config.env.lattice.enabled:
-        run_tasks(lattice_tasks(config.env), config.executor)
+    validator = None
+    if config.validation.enabled:
+        validator = LatticeValidator(config.env, config.validation, config.network)
+    if config.env.lattice.enabled or validator is not None:
+        tasks = lattice_tasks(config.env) if config.env.lattice.enabled else []
+        if validator is not None:
+            tasks += lattice_tasks(validation_env_config(config.env, config.validation))
+        run_tasks(tasks, config.executor)
+    best = resumed.get("validation") if resumed is not None else None  # {"frames", "score"} so far
 
     # Environment and collector (random actions until init_random_frames).
     in_process = None  # the env whose state checkpoints carry: one in this process
@@ -180,9 +194,12 @@ def train(config: TrainConfig) -> Path:
 
                 if frames - last_ckpt >= config.logger.checkpoint_every or frames >= config.collector.frames:
                     csv_file.flush()
+                    if validator is not None:
+                        best = validate_checkpoint(validator, run, config, loss_module.state_dict(),
+                                                   {"frames": frames, "updates": updates}, best)
                     plot_training_curves({run.name: csv_path}, run / "training.png")
                     write_checkpoint(ckpt_path, config, loss_module, optim_actor, optim_critic, buffer,
-                                     frames, updates, in_process)
+                                     frames, updates, in_process, best)
                     last_ckpt = frames
                 start = time.perf_counter()
     finally:
@@ -210,15 +227,43 @@ def sac_update(loss_module: SACLoss, optim_actor: torch.optim.Optimizer, optim_c
             "entropy": losses["entropy"].item(), "alpha": losses["alpha"].item()}
 
 
+def validate_checkpoint(validator: LatticeValidator, run: Path, config: TrainConfig, loss_state: dict,
+                        counters: dict[str, int], best: dict | None) -> dict:
+    """Score the actor on the validation buildings, log the row, and write `policy.pt` when it is the best
+    so far (ties keep the earlier actor); return the best {"frames", "score"}. The global random states
+    are kept, so a validated run trains exactly as an unvalidated one."""
+    state = rng_state()
+    scores = validator.score(actor_weights(loss_state))
+    set_rng_state(state)
+    score = float(sum(scores.values()) / len(scores))
+    if best is None or score > best["score"]:
+        save_policy(run / POLICY, json.dumps(config_record(config)), loss_state, counters)
+        best = {"frames": counters["frames"], "score": score}
+    path = run / VALIDATION_CSV
+    new = not path.exists()
+    with open(path, "a", newline="") as file:
+        log = csv.writer(file)
+        if new:
+            log.writerow(["frames", *scores, "mean", "best_frames"])
+        log.writerow([counters["frames"], *(f"{v:.3f}" for v in scores.values()), f"{score:.3f}",
+                      best["frames"]])
+    return best
+
+
 def write_checkpoint(path: Path, config: TrainConfig, loss_module: SACLoss,
                      optim_actor: torch.optim.Optimizer, optim_critic: torch.optim.Optimizer,
-                     buffer: ReplayBuffer, frames: int, updates: int, env: NBVEnv | None) -> Path:
-    """Save everything a resumed run needs (see the module docstring), and the policy file beside it."""
+                     buffer: ReplayBuffer, frames: int, updates: int, env: NBVEnv | None,
+                     best: dict | None = None) -> Path:
+    """Save everything a resumed run needs (see the module docstring), and beside it the policy file, or
+    with validation the best validation score so far (`validate_checkpoint` writes that policy file)."""
     state = {"config": json.dumps(config_record(config)), "loss": loss_module.state_dict(),
              "optim_actor": optim_actor.state_dict(), "optim_critic": optim_critic.state_dict(),
              "buffer": buffer.state_dict(), "counters": {"frames": frames, "updates": updates},
              "rng": rng_state()}
     if env is not None:
         state["env"] = env.snapshot()
-    save_policy(path.parent / POLICY, state["config"], state["loss"], state["counters"])
+    if config.validation.enabled:
+        state["validation"] = best
+    else:
+        save_policy(path.parent / POLICY, state["config"], state["loss"], state["counters"])
     return save_checkpoint(path, state)

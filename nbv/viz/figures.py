@@ -172,8 +172,10 @@ def plot_training_curves(runs: dict[str, str | Path], out: str | Path, window: i
         window: frames averaged over for each point (`training_curves`).
     """
     panels = (("reward", "reward per step"), ("return", "episode return"), ("steps", "steps per episode"))
-    fig = Figure(figsize=(13, 3.8))
-    axes = fig.subplots(1, len(panels))
+    validations = {label: Path(csv_path).with_name("validation.csv") for label, csv_path in runs.items()}
+    validations = {label: path for label, path in validations.items() if path.is_file()}
+    fig = Figure(figsize=(13 + 4.3 * bool(validations), 3.8))
+    axes = fig.subplots(1, len(panels) + bool(validations))
     for label, csv_path in runs.items():
         curves = training_curves(csv_path, window)
         for ax, (key, _) in zip(axes, panels):
@@ -181,6 +183,16 @@ def plot_training_curves(runs: dict[str, str | Path], out: str | Path, window: i
     for ax, (_, title) in zip(axes, panels):
         ax.set(xlabel="frames (environment steps)", title=f"{title} (last {window} frames)")
         ax.grid(alpha=0.3)
+    for label, path in validations.items():
+        table = np.genfromtxt(path, delimiter=",", names=True, dtype=np.float64)
+        frames, mean = np.atleast_1d(table["frames"]), np.atleast_1d(table["mean"])
+        line, = axes[-1].plot(frames, mean, marker=".", label=label)
+        best = int(np.argmax(mean))
+        axes[-1].plot(frames[best], mean[best], "*", markersize=12, color=line.get_color())
+    if validations:
+        axes[-1].set(xlabel="frames (environment steps)", ylabel="visible coverage %",
+                     title="validation buildings (star: policy.pt)")
+        axes[-1].grid(alpha=0.3)
     axes[0].legend(fontsize=8)
     return save_figure(fig, out)
 

@@ -1,0 +1,87 @@
+"""Checkpoint selection on validation buildings: the policy's mode scored by what its views see.
+
+Training return measures the Bag of Views reward, not the reconstruction, and it varies with the
+start views and buildings of the episodes that happen to be sampled; a policy picked by it can fly
+one tilted ring (docs/rl.md). So `nbv train` with validation buildings scores the actor at every
+checkpoint: from the same seeded start views on each validation building, its mode flies a fixed
+number of views on the building's view lattice (the training cache, so no view is rendered again),
+and the score is the share of the true surface those views see (`nbv.recon.visibility`, a ray-cast
+depth test of each snapped view's exact pose). `policy.pt` keeps the best-scoring actor. The views
+are snapped as in training; evaluation (`nbv plan`, `nbv online`) renders exact viewpoints.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+import torch
+
+from nbv.recon.visibility import SurfaceVisibility, scene_visibility
+from nbv.rl.agent import make_actor
+from nbv.rl.config import EnvConfig, NetworkConfig, ValidationConfig
+from nbv.rl.env import NBVEnv
+from nbv.rl.rollout import policy_views
+from render.viewpoint import viewpoint_to_c2w
+from scenes.spec import SceneSet
+
+
+def validation_env_config(env: EnvConfig, validation: ValidationConfig) -> EnvConfig:
+    """The training env on the validation buildings, on view lattices (the training lattice settings)."""
+    scenes = SceneSet(scene=validation.validation_scenes, up_axis=env.scenes.up_axis)
+    return replace(env, scenes=scenes, lattice=replace(env.lattice, enabled=True))
+
+
+class LatticeValidator:
+    """Scores actor weights on the validation buildings (mean visible coverage, %, per building).
+
+    Args:
+        env: the training env config (its camera, lattice, action mode and Bag of Views are used).
+        validation: buildings, episodes and views.
+        network: the actor's sizes.
+    """
+
+    def __init__(self, env: EnvConfig, validation: ValidationConfig, network: NetworkConfig) -> None:
+        self.validation = validation
+        self.config = validation_env_config(env, validation)
+        with torch.random.fork_rng():  # its initial weights are overwritten: draw none of training's numbers
+            self.actor = make_actor(env.history, env.obs_size, network)
+        self.actor.eval()
+        self._envs: dict[str, NBVEnv] = {}
+        self._visibility: dict[str, SurfaceVisibility] = {}
+        self._seen: dict[tuple[str, bytes], np.ndarray] = {}
+
+    def score(self, weights: dict[str, torch.Tensor]) -> dict[str, float]:
+        """Visible coverage (%) of each validation building by the actor's mode, mean over the episodes."""
+        self.actor.load_state_dict(weights)
+        scores = {}
+        for spec in self.config.scenes.specs():
+            env = self._env(spec.scene)
+            runs = []
+            for episode in range(self.validation.validation_episodes):
+                env.set_seed(episode)
+                views = policy_views(self.actor, env, self.validation.validation_views)
+                runs.append(self._coverage(spec.scene, env, views))
+            scores[spec.scene] = 100.0 * float(np.mean(runs))
+        return scores
+
+    def _env(self, scene: str) -> NBVEnv:
+        if scene not in self._envs:
+            config = replace(self.config, scenes=replace(self.config.scenes, scene=(scene,)))
+            self._envs[scene] = NBVEnv(config)
+        return self._envs[scene]
+
+    def _coverage(self, scene: str, env: NBVEnv, views: list[Any]) -> float:
+        """The share of the building's surface samples seen by the (snapped, so memoised) views."""
+        if scene not in self._visibility:
+            self._visibility[scene] = scene_visibility(env.scene, self.config.camera,
+                                                       self.validation.validation_points)
+        visibility = self._visibility[scene]
+        seen = np.zeros(len(visibility.samples), dtype=bool)
+        for view in views:
+            key = (scene, view.as_array().tobytes())
+            if key not in self._seen:
+                self._seen[key] = visibility.seen(viewpoint_to_c2w(view, env.scene.center()))
+            seen |= self._seen[key]
+        return float(seen.mean())

@@ -1,0 +1,87 @@
+"""Checkpoint selection on validation buildings: the score against a direct count, and training with it."""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import replace
+
+import numpy as np
+import pytest
+import torch
+
+from nbv.recon.visibility import scene_visibility
+from nbv.rl.agent import make_actor
+from nbv.rl.checkpoint import load_checkpoint, load_policy
+from nbv.rl.config import LatticeConfig, ValidationConfig
+from nbv.rl.env import NBVEnv
+from nbv.rl.rollout import policy_views
+from nbv.rl.train import train
+from nbv.rl.validate import LatticeValidator, validation_env_config
+from render.viewpoint import viewpoint_to_c2w
+from tests.nbv.rl.test_train import tiny
+
+SMALL_LATTICE = LatticeConfig(lattice_radii=1, lattice_azimuths=4, lattice_elevations=2)
+VALIDATION = ValidationConfig(validation_scenes=("test_building",), validation_episodes=2, validation_views=3,
+                              validation_points=2000)
+
+
+@pytest.fixture
+def cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("NBV_CACHE_DIR", str(tmp_path / "cache"))
+
+
+def validated(out, frames: int, validation: ValidationConfig = VALIDATION):
+    config = tiny(out, frames)
+    return replace(config, env=replace(config.env, lattice=SMALL_LATTICE), validation=validation,
+                   logger=replace(config.logger, checkpoint_every=2))
+
+
+def test_score_is_the_visible_coverage_of_the_modes_lattice_views(tmp_path, cache):
+    config = validated(tmp_path, 2)
+    actor = make_actor(config.env.history, config.env.obs_size, config.network)
+    weights = actor.state_dict()
+    scores = LatticeValidator(config.env, VALIDATION, config.network).score(weights)
+
+    env_config = validation_env_config(config.env, VALIDATION)
+    assert env_config.lattice.enabled and env_config.scenes.scene == ("test_building",)
+    env = NBVEnv(env_config)
+    visibility = None
+    coverages = []
+    for episode in range(2):
+        env.set_seed(episode)
+        views = policy_views(actor, env, 3)
+        assert len(views) == 3
+        visibility = visibility or scene_visibility(env.scene, env_config.camera, 2000)
+        poses = [viewpoint_to_c2w(v, env.scene.center()) for v in views]
+        coverages.append(visibility.coverage(poses))
+    assert list(scores) == ["test_building"]
+    assert scores["test_building"] == pytest.approx(100 * np.mean(coverages))
+    assert 0 < scores["test_building"] <= 100
+
+
+def test_validated_training_keeps_the_best_policy_and_trains_as_without(tmp_path, cache):
+    plain = load_checkpoint(train(replace(validated(tmp_path / "plain", 6), validation=ValidationConfig())))
+    ckpt = load_checkpoint(train(validated(tmp_path / "run", 6)))
+    for key in plain["loss"]:  # validation consumes none of the training's random numbers
+        assert torch.equal(plain["loss"][key], ckpt["loss"][key]), key
+    assert "validation" not in plain
+
+    with open(tmp_path / "run" / "validation.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert [int(r["frames"]) for r in rows] == [2, 4, 6]
+    means = [float(r["mean"]) for r in rows]
+    best = int(np.argmax(means))  # the first of equal scores
+    assert ckpt["validation"] == {"frames": 2 * (best + 1), "score": pytest.approx(means[best], abs=1e-3)}
+    assert all(int(r["best_frames"]) <= int(r["frames"]) for r in rows)
+    _, weights = load_policy(tmp_path / "run" / "policy.pt")
+    policy = torch.load(tmp_path / "run" / "policy.pt", weights_only=True)
+    assert policy["counters"]["frames"] == 2 * (best + 1)
+    config = validated(tmp_path, 6)
+    rescored = LatticeValidator(config.env, VALIDATION, config.network).score(weights)
+    assert rescored["test_building"] == pytest.approx(means[best], abs=1e-3)
+
+
+def test_bad_validation_settings_are_refused():
+    with pytest.raises(ValueError, match="validation_views must be >= 1"):
+        ValidationConfig(validation_views=0)
+    assert not ValidationConfig().enabled and VALIDATION.enabled

@@ -32,12 +32,11 @@ from nbv.planning.planners import Planner, PolicyPlanner, make_planner
 from nbv.recon.visibility import scene_visibility
 from nbv.rl.config import EnvConfig, LatticeConfig
 from nbv.rl.env import NBVEnv
+from nbv.rl.presets import TRAIN_SCENES, VALIDATION_SCENES
 from nbv.viz.figures import plot_seed_scores
 from render.viewpoint import viewpoint_to_c2w
 from scenes.spec import SceneSet
 
-TRAIN_SCENES = ("medieval_tavern", "forest_ruin_house", "random:1", "random:2", "random:3", "random:4")
-VALIDATION_SCENES = ("random:6", "random:7", "random:8")
 BASE = ("--preset", "paper", "--width", "160", "--height", "120", "--spp", "4", "--feature-backend", "opencv",
         "--lattice", "--relative-step", "0.125", "--threads", "1", "--no-progress")
 CANDIDATES = {
@@ -95,12 +94,12 @@ def validation_score(planner: Planner, env_config: EnvConfig, views: int, episod
 
 def score_all(args: argparse.Namespace) -> None:
     """Score every finished run and the random and circle baselines; write selection.{json,md,png}."""
-    runs = sorted(p.parent for p in args.runs.glob("*-seed*/checkpoint.pt"))
+    runs = sorted(p.parent for p in args.runs.glob("*-seed*/policy.pt"))
     scores: dict[str, dict[int, float]] = {}
     env_config = None
     for run in tqdm(runs, desc="score runs", unit="run"):
         name, seed = run.name.rsplit("-seed", 1)
-        planner = PolicyPlanner(run / "checkpoint.pt")
+        planner = PolicyPlanner(run / "policy.pt")  # the actor the run chose (without validation: the last)
         env_config = planner.env_config
         key = {"views": args.views, "episodes": args.episodes, "scenes": VALIDATION_SCENES,
                "frames": json.loads((run / "config.json").read_text())["collector"]["frames"]}

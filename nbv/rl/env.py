@@ -28,6 +28,13 @@ Termination: one pass around the target, i.e. the net azimuth travelled
 (each step's change wrapped to (-pi, pi]) reaches 2 pi in either direction.
 Truncation: `max_steps` steps.
 
+Lattice (training): the env's viewpoint stays the exact one the actions lead
+to (steps accumulate, and the state records it); only the frame and the
+descriptors come from the nearest lattice node. Snapping the viewpoint itself
+kept relative steps smaller than half a node spacing from ever moving the
+camera (R never changed, elevation only at |action| > 0.8), so policies
+trained that way flew one ring at their start elevation.
+
 Rendering: one renderer per scene (loaded with the scene set's up axis),
 created lazily on the first reset, in the process that steps the env, so
 `ParallelEnv`'s spawned workers each choose their own Mitsuba variant; view k
@@ -175,7 +182,7 @@ class NBVEnv(EnvBase):
         self._episode += 1
         low, high = self.config.low, self.config.high
         radius, azimuth, elevation = low + self._rng.random(3) * (high - low)
-        self._view = self.snap(Viewpoint(float(radius), float(azimuth), float(elevation)))
+        self._view = Viewpoint(float(radius), float(azimuth), float(elevation))
         self.bov.reset()
         frame, descriptors = self.capture(self._view)
         self.bov.update(descriptors, self._view.azimuth, self._view.elevation)
@@ -187,7 +194,7 @@ class NBVEnv(EnvBase):
         return self._observation()
 
     def _step(self, tensordict: TensorDictBase) -> TensorDictBase:
-        view = self.snap(action_to_viewpoint(tensordict["action"], self._view, self.config))
+        view = action_to_viewpoint(tensordict["action"], self._view, self.config)
         frame, descriptors = self.capture(view)
         reward = self.bov.reward(descriptors, view.azimuth, view.elevation)
         self._progress += wrap_angle(view.azimuth - self._view.azimuth)
@@ -279,14 +286,10 @@ class NBVEnv(EnvBase):
         self._depths_rendered += 1
         return depth
 
-    def snap(self, view: Viewpoint) -> Viewpoint:
-        """`view` itself, or with a lattice (training) the nearest lattice node of the current scene."""
-        return self._lattice(self._scene).snap(view)[0] if self.config.lattice.enabled else view
-
     def capture(self, view: Viewpoint) -> tuple[np.ndarray, torch.Tensor]:
         """The policy frame (S x S uint8) and SIFT descriptors (M, 128) of `view` of the current scene.
 
-        Rendered, or with a lattice read from the cache at the nearest node (`snap` first to see it).
+        Rendered, or with a lattice read from the cache at the nearest node.
         """
         apply_thread_policy()  # here, not in __init__: in the process that steps the env
         if self.config.lattice.enabled:

@@ -5,12 +5,13 @@ against a few ms for the Bag of Views). With a lattice, each scene's views on
 a grid of (R, azimuth, elevation) are rendered once at the training settings;
 the policy frame and the SIFT descriptors of every node are cached on disk,
 keyed by scene content, camera, render settings, lattice, frame size and
-feature settings. During training the env snaps each requested viewpoint to
-the nearest node (azimuth on the circle); evaluation and `nbv plan` render
-exact viewpoints. The snapping error is at most half a step per coordinate:
-`LatticeConfig.max_error`. Before training, each scene's lattice is a unit of
-work (`lattice_tasks`): `nbv train --workers N` or `--ray` renders them side by
-side, and envs (Ray actors included) then only read the cache.
+feature settings. During training the env keeps the exact viewpoint and
+shows the frame and descriptors of its nearest node (azimuth on the circle);
+evaluation and `nbv plan` render exact viewpoints. The image's snapping error
+is at most half a step per coordinate: `EnvConfig.snapping_error`. Before
+training, each scene's lattice is a unit of work (`lattice_tasks`): `nbv
+train --workers N` or `--ray` renders them side by side, and envs (Ray
+actors included) then only read the cache.
 """
 
 from __future__ import annotations

@@ -6,8 +6,8 @@ one tilted ring (docs/rl.md). So `nbv train` with validation buildings scores th
 checkpoint: from the same seeded start views on each validation building, its mode flies a fixed
 number of views on the building's view lattice (the training cache, so no view is rendered again),
 and the score is the share of the true surface those views see (`nbv.recon.visibility`, a ray-cast
-depth test of each snapped view's exact pose). `policy.pt` keeps the best-scoring actor. The views
-are snapped as in training; evaluation (`nbv plan`, `nbv online`) renders exact viewpoints.
+depth test at each view's exact pose). `policy.pt` keeps the best-scoring actor. The policy sees the
+nearest nodes' frames as in training; evaluation (`nbv plan`, `nbv online`) renders exact viewpoints.
 """
 
 from __future__ import annotations
@@ -73,7 +73,8 @@ class LatticeValidator:
         return self._envs[scene]
 
     def _coverage(self, scene: str, env: NBVEnv, views: list[Any]) -> float:
-        """The share of the building's surface samples seen by the (snapped, so memoised) views."""
+        """The share of the building's surface samples seen by the views (memoised: a converged mode
+        flies the same views at many checkpoints)."""
         if scene not in self._visibility:
             self._visibility[scene] = scene_visibility(env.scene, self.config.camera,
                                                        self.validation.validation_points)

@@ -7,7 +7,7 @@ import pytest
 from nbv.cli import main
 from nbv.cli.train import parse_train as parsed
 from nbv.cli.train import split_preset
-from nbv.rl.presets import TRAIN_SCENES
+from nbv.rl.presets import TRAIN_SCENES, VALIDATION_SCENES
 from scenes.presets import seed_split
 
 
@@ -23,6 +23,10 @@ def test_paper_preset_is_table_1_and_default_departs_from_it():
     held_out = [s for s in TRAIN_SCENES if s in ("alpine_chalet", "imperial_temple")
                 or s.startswith("random:") and seed_split(int(s[7:])) == "test"]
     assert held_out == []  # the held-out buildings are never trained on
+    assert not paper.validation.enabled  # the paper keeps the last actor
+    validation = default.validation.validation_scenes
+    assert validation == VALIDATION_SCENES and not set(validation) & set(TRAIN_SCENES)
+    assert all(seed_split(int(s[7:])) == "train" for s in validation)  # never a test building
 
 
 def test_flags_override_the_preset_and_scenes_replace_its_list():

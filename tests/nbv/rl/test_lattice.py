@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 import torch
+from tensordict import TensorDict
 
 from nbv.bov.config import BoVConfig
 from nbv.features.sift import extract_features
@@ -64,13 +65,13 @@ def test_env_on_a_lattice_sees_cached_node_renders_and_reuses_the_cache(monkeypa
     cfg = config(grid, camera=UAVCamera(64, 48), render=RenderSettings(spp=1), obs_size=16,
                  bov=BoVConfig(ranges=4, words=5, features="opencv"), action_mode="orbit")
     env = NBVEnv(cfg, seed=3)
-    env.reset()
+    td = env.reset()
     start = env.viewpoint
-    assert start in [Viewpoint(r, a, e) for r, a, e in np.stack(np.meshgrid(*lattice_axes(cfg),
-                                                                           indexing="ij"), -1).reshape(-1, 3)]
-    # The cached node equals a direct render of that node with the node's seed (its index).
+    # The env shows the frame of the start's nearest node, which equals a direct render of that node with
+    # the node's seed (its index).
     lattice = env._lattice(env._scene)
     node, index = lattice.snap(start)
+    assert np.array_equal(td["pixels"][-1].numpy(), lattice.frames[index])
     renderer = env._renderer(env._scene)
     rgb = renderer.render_rgb(viewpoint_to_c2w(node, renderer.center), seed=index)
     frame, descriptors = lattice.observe(index)
@@ -83,7 +84,27 @@ def test_env_on_a_lattice_sees_cached_node_renders_and_reuses_the_cache(monkeypa
     again = NBVEnv(cfg, seed=3)
     td = again.rollout(3)
     assert td["next", "reward"].shape == (3, 1)
-    assert again.viewpoint.azimuth in lattice_axes(cfg)[1]
+
+
+def test_relative_steps_on_a_lattice_accumulate_from_the_exact_viewpoint(tmp_path, monkeypatch):
+    monkeypatch.setenv("NBV_CACHE_DIR", str(tmp_path))
+    grid = LatticeConfig(enabled=True, lattice_radii=3, lattice_azimuths=4, lattice_elevations=2)
+    cfg = config(grid, camera=UAVCamera(64, 48), render=RenderSettings(spp=1), obs_size=16,
+                 bov=BoVConfig(ranges=4, words=5, features="opencv"), action_mode="relative",
+                 relative_step=0.125)
+    env = NBVEnv(cfg, seed=1)
+    env.reset()
+    start = env.viewpoint
+    lattice = env._lattice(env._scene)
+    for _ in range(3):  # +0.04 m and +0.05 * 75 degrees a step: each far below half a node spacing
+        td = env.step(TensorDict({"action": torch.tensor([0.32, 0.0, 0.4])}, []))
+    radius = min(start.radius + 3 * 0.32 * 0.125 * 1.0, 2.5)
+    elevation = min(start.elevation + 3 * 0.4 * 0.125 * math.radians(75.0), math.radians(80.0))
+    assert env.viewpoint.radius == pytest.approx(radius)
+    assert env.viewpoint.elevation == pytest.approx(elevation)
+    assert env.viewpoint.azimuth == pytest.approx(start.azimuth)
+    assert td["next", "viewpoints"][-1, 0].item() == pytest.approx(2 * (radius - 1.5) - 1, abs=1e-6)
+    assert np.array_equal(td["next", "pixels"][-1].numpy(), lattice.frames[lattice.snap(env.viewpoint)[1]])
 
 
 def test_planning_env_renders_exact_viewpoints(tmp_path):

@@ -76,6 +76,10 @@ class EnvConfig:
     """Highest allowed elevation, degrees."""
     max_steps: int = 30
     """Step cap of an episode (truncation)."""
+    episode_views: int = 0
+    """0: an episode ends after one pass around the target (the paper) or at the step cap. N > 0: it ends
+    after N views, the start view included, wherever the camera is (a fixed view budget, beyond the
+    paper: training then matches a 13-view evaluation instead of stopping after one pass)."""
     action_mode: Literal["absolute", "relative", "orbit"] = "absolute"
     """Action meaning: the next viewpoint (paper), a step from the current one, or an azimuth step with
     absolute R and elevation (orbit)."""
@@ -94,6 +98,9 @@ class EnvConfig:
         for name in ("obs_size", "history", "max_steps"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
+        if self.episode_views == 1 or self.episode_views < 0 or self.episode_views > self.max_steps + 1:
+            raise ValueError(f"episode_views must be 0 (one pass) or lie in [2, max_steps + 1 = "
+                             f"{self.max_steps + 1}], got {self.episode_views}")
         if not 0 < self.relative_step <= 1:
             raise ValueError(f"relative_step must lie in (0, 1], got {self.relative_step}")
 

@@ -25,8 +25,9 @@ allowed elevations, beyond the paper). The BoV is
 emptied at each reset and learns the episode's first view without reward.
 
 Termination: one pass around the target, i.e. the net azimuth travelled
-(each step's change wrapped to (-pi, pi]) reaches 2 pi in either direction.
-Truncation: `max_steps` steps.
+(each step's change wrapped to (-pi, pi]) reaches 2 pi in either direction;
+or, with `episode_views` N > 0 (a fixed view budget, beyond the paper), the
+N-th view, and passes do not end it. Truncation: `max_steps` steps.
 
 Lattice (training): the env's viewpoint stays the exact one the actions lead
 to (steps accumulate, and the state records it); only the frame and the
@@ -202,7 +203,10 @@ class NBVEnv(EnvBase):
         self._steps += 1
         self._frames = np.concatenate([self._frames[1:], frame[None]])
         self._locations = np.concatenate([self._locations[1:], normalise_viewpoint(view, self.config)[None]])
-        terminated = abs(self._progress) >= TWO_PI - 1e-9
+        if self.config.episode_views:
+            terminated = self._steps + 1 >= self.config.episode_views
+        else:
+            terminated = abs(self._progress) >= TWO_PI - 1e-9
         truncated = not terminated and self._steps >= self.config.max_steps
         out = self._observation(terminated, truncated)
         out.set("reward", torch.tensor([reward], dtype=torch.float32))

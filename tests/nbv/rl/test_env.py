@@ -117,6 +117,19 @@ def test_back_and_forth_does_not_terminate_but_truncates():
     assert flags == [(False, False, False)] * 3 + [(False, True, True)]
 
 
+def test_a_view_budget_ends_the_episode_and_a_pass_does_not():
+    config = tiny_config(action_mode="relative", relative_step=0.25, max_steps=10, episode_views=6)
+    env = NBVEnv(config, seed=0)
+    td = env.reset()
+    flags = []
+    for _ in range(5):  # a full pass after four quarter turns, then a fifth step: the sixth view
+        td = env.step(td.set("action", torch.tensor([0.0, 1.0, 0.0])))["next"]
+        flags.append((bool(td["terminated"]), bool(td["truncated"])))
+    assert flags == [(False, False)] * 4 + [(True, False)]
+    with pytest.raises(ValueError, match="episode_views must be 0"):
+        tiny_config(episode_views=12, max_steps=10)
+
+
 @pytest.mark.parametrize("action, message", [
     ([float("nan"), 0.0, 0.0], "NaN"),
     ([1.5, 0.0, 0.0], r"\[-1, 1\]"),

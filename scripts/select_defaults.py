@@ -7,8 +7,11 @@ imperial_temple and random:SEED with SEED % 5 == 0 are never touched here). The 
 mode over `--episodes` start views per building, rendered at exact viewpoints, scored by the
 visible-surface coverage of the true mesh (`nbv.recon.visibility`).
 
-    python scripts/select_defaults.py train --runs runs/selection --frames 4000 --jobs 2
+    python scripts/select_defaults.py train --round 2 --runs runs/selection --frames 6000 --jobs 3
     python scripts/select_defaults.py score --runs runs/selection --out paper_results/selection
+
+(round 1, before the lattice fix: `train --round 1 --frames 4000`, scored into
+paper_results/selection/round1.)
 """
 
 from __future__ import annotations
@@ -48,17 +51,31 @@ CANDIDATES = {
     "orbit-bands2": ("--action-mode", "orbit", "--reward-scale", "0.1", "--elevation-bands", "2"),
     "relative-bands2": ("--action-mode", "relative", "--reward-scale", "0.1", "--elevation-bands", "2"),
 }
-"""Flags over the paper preset (Table 1), one factor at a time from `orbit` (the best design measured before):
-the action mode (absolute is the paper's), the entropy setting (fixed alpha 0.2 on raw rewards as in Table 1,
-or learned), and the Bag of Views ranges split into two elevation bands; then the two best factors together
-(`relative-bands2`, added once the first seeds of the others were scored)."""
+"""Round 1, flags over the paper preset (Table 1), one factor at a time from `orbit` (the best design measured
+before): the action mode (absolute is the paper's), the entropy setting (fixed alpha 0.2 on raw rewards as in
+Table 1, or learned), and the Bag of Views ranges split into two elevation bands; then the two best factors
+together (`relative-bands2`, added once the first seeds of the others were scored). Measured before the
+lattice fix (a snapped viewpoint kept small relative steps from moving the camera); each run keeps its last
+actor."""
+BASE2 = ("--preset", "default", "--threads", "1", "--no-progress")
+CANDIDATES2 = {
+    "one-pass": ("--episode-views", "0"),
+    "views13": ("--episode-views", "13"),
+}
+"""Round 2, after the lattice fix, flags over the default preset (`relative-bands2`, each checkpoint
+validated, `policy.pt` the best): episodes of one pass (the paper) or of 13 views (the evaluation's
+budget)."""
+ROUNDS = {1: (BASE, CANDIDATES), 2: (BASE2, CANDIDATES2)}
+"""`--round N`: the base command and candidates of each selection round."""
 
 
-def train_one(run: Path, flags: tuple[str, ...], seed: int, frames: int) -> float:
+def train_one(run: Path, flags: tuple[str, ...], seed: int, frames: int, round_: int) -> float:
     """Train one run (resumes a finished or partial one); return its wall time in seconds."""
     scenes = [arg for scene in TRAIN_SCENES for arg in ("--scene", scene)]
-    command = ["nbv", "train", *scenes, *BASE, *flags, "--seed", str(seed), "--frames", str(frames),
-               "--checkpoint-every", str(frames), "--out", str(run)]
+    # Round 1 checkpointed once, at the end; round 2 keeps the preset's cadence (each checkpoint validated).
+    every = ("--checkpoint-every", str(frames)) if round_ == 1 else ()
+    command = ["nbv", "train", *scenes, *ROUNDS[round_][0], *flags, "--seed", str(seed),
+               "--frames", str(frames), *every, "--out", str(run)]
     start = time.perf_counter()
     run.mkdir(parents=True, exist_ok=True)
     with open(run / "train.log", "a") as log:
@@ -68,10 +85,11 @@ def train_one(run: Path, flags: tuple[str, ...], seed: int, frames: int) -> floa
 
 def train_all(args: argparse.Namespace) -> None:
     """Every candidate x seed, `--jobs` at a time (seeds interleaved, so a cut run still compares)."""
-    jobs = [(name, seed) for seed, name in itertools.product(args.seeds, args.candidates)]
+    candidates = ROUNDS[args.round][1]
+    jobs = [(name, seed) for seed, name in itertools.product(args.seeds, args.candidates or candidates)]
     with ThreadPoolExecutor(args.jobs) as pool:
-        futures = {pool.submit(train_one, args.runs / f"{name}-seed{seed}", CANDIDATES[name], seed,
-                               args.frames): (name, seed) for name, seed in jobs}
+        futures = {pool.submit(train_one, args.runs / f"{name}-seed{seed}", candidates[name], seed,
+                               args.frames, args.round): (name, seed) for name, seed in jobs}
         for future, (name, seed) in futures.items():
             print(f"{name} seed {seed}: {future.result():.0f} s", flush=True)
 
@@ -128,7 +146,7 @@ def score_all(args: argparse.Namespace) -> None:
                          "visible coverage % (validation)", "nbv train candidates", baselines)
         write_json(out / "selection.json", {
             "commit": git_commit(), "train_scenes": TRAIN_SCENES, "validation_scenes": VALIDATION_SCENES,
-            "views": args.views, "episodes": args.episodes, "base": BASE, "candidates": CANDIDATES,
+            "views": args.views, "episodes": args.episodes, "rounds": ROUNDS,
             "scores": scores, "baselines": baselines,
             "frames": {run.name: json.loads((run / "config.json").read_text())["collector"]["frames"]
                        for run in runs}})
@@ -143,7 +161,9 @@ def main() -> None:
     train.add_argument("--frames", type=int, default=4000)
     train.add_argument("--jobs", type=int, default=2)
     train.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
-    train.add_argument("--candidates", nargs="+", default=list(CANDIDATES), choices=list(CANDIDATES))
+    train.add_argument("--round", type=int, default=2, choices=list(ROUNDS))
+    train.add_argument("--candidates", nargs="+", choices=[*CANDIDATES, *CANDIDATES2],
+                       help="default: every candidate of the round")
     score = sub.add_parser("score")
     score.add_argument("--runs", type=Path, required=True)
     score.add_argument("--out", type=Path, required=True)

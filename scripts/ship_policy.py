@@ -1,8 +1,8 @@
 """Copy a finished `nbv train` run into the package as the shipped policy (issue 11).
 
-Writes DEST/policy.pt (the actor and config, `weights_only`-loadable), config.json, metrics.csv and
-training.png. The run's output folder in the recorded config is replaced by `--name` (a relative
-path), so no machine path is committed; nothing else changes.
+Writes DEST/policy.pt (the actor and config, `weights_only`-loadable), config.json, metrics.csv,
+training.png and, for a validated run, validation.csv. The run's output folder in the recorded config
+is replaced by `--name` (a relative path), so no machine path is committed; nothing else changes.
 
     python scripts/ship_policy.py --run runs/default --dest nbv/planning/shipped --name runs/default
 """
@@ -31,8 +31,9 @@ def main() -> None:
     save_policy(args.dest / "policy.pt", json.dumps(config),
                 {f"actor_network_params.{k}": v for k, v in state["actor"].items()}, state["counters"])
     write_json(args.dest / "config.json", config)
-    for name in ("metrics.csv", "training.png"):
-        shutil.copyfile(args.run / name, args.dest / name)
+    for name in ("metrics.csv", "training.png", "validation.csv"):
+        if name != "validation.csv" or (args.run / name).is_file():
+            shutil.copyfile(args.run / name, args.dest / name)
 
 
 if __name__ == "__main__":

@@ -256,6 +256,8 @@ INDEX = (
            "chalet", "nbv compare (command in the file)"),
     Result("selection/selection.md", "selection/selection.json", "choice of the default training settings "
            "on validation buildings", "scripts/select_defaults.py"),
+    Result("selection/round1/selection.md", "selection/round1/selection.json", "its first round, before the "
+           "lattice fix", "scripts/select_defaults.py --round 1"),
 )
 """Every result `README.md` may map, in its order."""
 SEED_KEYS = ("episode_seeds", "seeds")

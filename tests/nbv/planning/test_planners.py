@@ -163,7 +163,7 @@ def test_shipped_policy_is_the_default_training_command_and_plans():
     assert raw["format"] == "nbv-sac-policy" and SHIPPED_POLICY.stat().st_size < 5_000_000
     shipped = with_defaults(json.loads(raw["config"]))  # settings added since then at their defaults
     default = config_record(parse_train(["--out", "runs/default"]))
-    for group in ("env", "collector", "replay_buffer", "optim", "network"):
+    for group in ("env", "collector", "replay_buffer", "optim", "network", "validation"):
         assert shipped[group] == default[group], group  # `nbv train --out runs/default` retrains it
     planner = make_planner("policy")
     assert isinstance(planner, PolicyPlanner) and planner.env_config.bov.elevation_bands == 2

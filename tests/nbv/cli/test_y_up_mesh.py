@@ -71,7 +71,7 @@ def test_train_flies_around_a_y_up_obj(tmp_path, monkeypatch):
     monkeypatch.setattr(scenes.catalog, "load_scene", spy)
     run = tmp_path / "run"
     args = ["train", "--scene", str(obj), "--up-axis", "y", *TINY, "--obs-size", "32", "--max-steps", "3",
-            "--feature-backend", "opencv", "--frames", "2", "--frames-per-batch", "2",
+            "--episode-views", "0", "--feature-backend", "opencv", "--frames", "2", "--frames-per-batch", "2",
             "--init-random-frames", "2", "--validation-scenes", "--out", str(run), "--no-progress"]
     assert main(args) == 0
     assert load_checkpoint(run / "checkpoint.pt")["counters"]["frames"] == 2

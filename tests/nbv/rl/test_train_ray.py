@@ -16,9 +16,7 @@ from nbv.rl.config import CollectorConfig, EnvConfig, NetworkConfig
 from render.camera import UAVCamera
 from render.settings import RenderSettings
 from scenes.spec import SceneSet
-
-TINY_ENV = ["--scene", "test_building", "--width", "64", "--height", "48", "--spp", "1", "--obs-size", "32",
-            "--max-steps", "3", "--feature-backend", "opencv"]
+from tests.nbv.rl.test_train import TINY_ENV
 
 
 def test_a_ray_collected_run_checkpoints_and_resumes(tmp_path, monkeypatch):

@@ -1,8 +1,8 @@
 """Checkpoint selection on validation buildings: the policy's mode scored by what its views see.
 
 Training return measures the Bag of Views reward, not the reconstruction, and it varies with the
-start views and buildings of the episodes that happen to be sampled; a policy picked by it can fly
-one tilted ring (docs/rl.md). So `nbv train` with validation buildings scores the actor at every
+start views and buildings of the episodes that happen to be sampled; the last actor of a run is not
+its best (docs/rl.md §11). So `nbv train` with validation buildings scores the actor at every
 checkpoint: from the same seeded start views on each validation building, its mode flies a fixed
 number of views on the building's view lattice (the training cache, so no view is rendered again),
 and the score is the share of the true surface those views see (`nbv.recon.visibility`, a ray-cast
@@ -13,7 +13,6 @@ nearest nodes' frames as in training; evaluation (`nbv plan`, `nbv online`) rend
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any
 
 import numpy as np
 import torch
@@ -23,7 +22,7 @@ from nbv.rl.agent import make_actor
 from nbv.rl.config import EnvConfig, NetworkConfig, ValidationConfig
 from nbv.rl.env import NBVEnv
 from nbv.rl.rollout import policy_views
-from render.viewpoint import viewpoint_to_c2w
+from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes.spec import SceneSet
 
 
@@ -72,7 +71,7 @@ class LatticeValidator:
             self._envs[scene] = NBVEnv(config)
         return self._envs[scene]
 
-    def _coverage(self, scene: str, env: NBVEnv, views: list[Any]) -> float:
+    def _coverage(self, scene: str, env: NBVEnv, views: list[Viewpoint]) -> float:
         """The share of the building's surface samples seen by the views (memoised: a converged mode
         flies the same views at many checkpoints)."""
         if scene not in self._visibility:

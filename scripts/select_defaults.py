@@ -62,11 +62,13 @@ CANDIDATES2 = {
     "one-pass": ("--episode-views", "0"),
     "views13": ("--episode-views", "13"),
     "orbit-views13": ("--episode-views", "13", "--action-mode", "orbit"),
+    "views13-step0.25": ("--episode-views", "13", "--relative-step", "0.25"),
 }
 """Round 2, after the lattice fix, flags over the default preset (`relative-bands2`, each checkpoint
 validated, `policy.pt` the best): episodes of one pass (the paper) or of 13 views (the evaluation's
 budget); then, after views13 was chosen and evaluated, orbit actions with 13-view episodes (absolute R and
-elevation: a start elevation cannot linger), against the seed spread views13 showed."""
+elevation: a start elevation cannot linger) and relative steps twice as long, against the seed spread
+views13 showed."""
 ROUNDS = {1: (BASE, CANDIDATES), 2: (BASE2, CANDIDATES2)}
 """`--round N`: the base command and candidates of each selection round."""
 

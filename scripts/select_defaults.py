@@ -90,6 +90,9 @@ def train_one(run: Path, flags: tuple[str, ...], seed: int, frames: int, round_:
 def train_all(args: argparse.Namespace) -> None:
     """Every candidate x seed, `--jobs` at a time (seeds interleaved, so a cut run still compares)."""
     candidates = ROUNDS[args.round][1]
+    unknown = sorted(set(args.candidates or ()) - set(candidates))
+    if unknown:
+        raise SystemExit(f"not candidates of round {args.round}: {', '.join(unknown)}")
     jobs = [(name, seed) for seed, name in itertools.product(args.seeds, args.candidates or candidates)]
     with ThreadPoolExecutor(args.jobs) as pool:
         futures = {pool.submit(train_one, args.runs / f"{name}-seed{seed}", candidates[name], seed,

@@ -31,9 +31,9 @@ def main() -> None:
     save_policy(args.dest / "policy.pt", json.dumps(config),
                 {f"actor_network_params.{k}": v for k, v in state["actor"].items()}, state["counters"])
     write_json(args.dest / "config.json", config)
-    for name in ("metrics.csv", "training.png", "validation.csv"):
-        if name != "validation.csv" or (args.run / name).is_file():
-            shutil.copyfile(args.run / name, args.dest / name)
+    optional = [] if not (args.run / "validation.csv").is_file() else ["validation.csv"]
+    for name in ("metrics.csv", "training.png", *optional):
+        shutil.copyfile(args.run / name, args.dest / name)
 
 
 if __name__ == "__main__":

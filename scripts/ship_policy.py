@@ -1,8 +1,10 @@
 """Copy a finished `nbv train` run into the package as the shipped policy (issue 11).
 
-Writes DEST/policy.pt (the actor and config, `weights_only`-loadable), config.json, metrics.csv,
-training.png and, for a validated run, validation.csv. The run's output folder in the recorded config
-is replaced by `--name` (a relative path), so no machine path is committed; nothing else changes.
+Writes DEST/policy.pt (the actor and config, `weights_only`-loadable), config.json, training.png and
+the logs: metrics.csv and, for a validated run, validation.csv; for a run of several members
+(`--members`), members.csv and each member's config.json, metrics.csv and validation.csv in memberK/.
+The run's output folder in the recorded configs is replaced by `--name` (a relative path), so no
+machine path is committed; nothing else changes.
 
     python scripts/ship_policy.py --run runs/default --dest nbv/planning/shipped --name runs/default
 """
@@ -16,6 +18,7 @@ from pathlib import Path
 
 from common.io import write_json
 from nbv.rl.checkpoint import POLICY_FORMAT, checkpoint_config, load_checkpoint, save_policy
+from nbv.rl.members import MEMBERS_CSV
 
 
 def main() -> None:
@@ -31,10 +34,24 @@ def main() -> None:
     save_policy(args.dest / "policy.pt", json.dumps(config),
                 {f"actor_network_params.{k}": v for k, v in state["actor"].items()}, state["counters"])
     write_json(args.dest / "config.json", config)
-    optional = [] if not (args.run / "validation.csv").is_file() else ["validation.csv"]
-    for name in ("metrics.csv", "training.png", *optional):
-        shutil.copyfile(args.run / name, args.dest / name)
+    shutil.copyfile(args.run / "training.png", args.dest / "training.png")
+    if (args.run / MEMBERS_CSV).is_file():  # a run of several seeds: each one's logs in memberK/
+        shutil.copyfile(args.run / MEMBERS_CSV, args.dest / MEMBERS_CSV)
+        for member in sorted(p for p in args.run.glob("member*") if p.is_dir()):
+            recorded = json.loads((member / "config.json").read_text())
+            recorded["logger"]["out"] = f"{args.name}/{member.name}"
+            (args.dest / member.name).mkdir(exist_ok=True)
+            write_json(args.dest / member.name / "config.json", recorded)
+            copy_logs(member, args.dest / member.name)
+    else:
+        copy_logs(args.run, args.dest)
 
+
+def copy_logs(run: Path, dest: Path) -> None:
+    """A run's metrics.csv and, if it was validated, its validation.csv."""
+    for name in ("metrics.csv", "validation.csv"):
+        if name == "metrics.csv" or (run / name).is_file():
+            shutil.copyfile(run / name, dest / name)
 
 if __name__ == "__main__":
     main()

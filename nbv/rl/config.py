@@ -256,11 +256,18 @@ class ValidationConfig:
     """Views per validation episode, the start view included."""
     validation_points: int = 20_000
     """True-surface samples of the coverage score per building."""
+    members: int = 1
+    """Independent training runs of the command (seeds seed*members .. seed*members + members-1, in
+    RUN/memberK/, side by side where --workers says); `policy.pt` is the best-validated actor of them all
+    (`nbv.rl.members`). 1: one run, in RUN itself."""
 
     def __post_init__(self) -> None:
-        for name in ("validation_episodes", "validation_views", "validation_points"):
+        for name in ("validation_episodes", "validation_views", "validation_points", "members"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
+        if self.members > 1 and not self.validation_scenes:
+            raise ValueError(f"members ({self.members}) are compared on validation buildings: give "
+                             "--validation-scenes")
 
     @property
     def enabled(self) -> bool:
@@ -301,5 +308,5 @@ class TrainConfig:
     validation: ValidationConfig = ValidationConfig()
     """Checkpoint selection on validation buildings (off by default; on in the `default` preset)."""
     executor: ExecutorConfig = ExecutorConfig()
-    """Where the scenes' view lattices are rendered before training (--lattice): this process, local
-    workers or Ray."""
+    """Where the scenes' view lattices are rendered before training (--lattice), and where the members
+    train (--members): this process, local workers or Ray."""

@@ -95,7 +95,12 @@ def with_defaults(saved: dict) -> dict:
 def train(config: TrainConfig) -> Path:
     """Train (or resume training) into `config.logger.out`; return the checkpoint path.
 
-    `policy.pt` beside it holds the actor alone (what `nbv plan --planner policy:RUN/policy.pt` needs)."""
+    `policy.pt` beside it holds the actor alone (what `nbv plan --planner policy:RUN/policy.pt` needs). With
+    `--members K` the command trains K seeds (`nbv.rl.members`) and returns the kept member's checkpoint."""
+    if config.validation.members > 1:
+        from nbv.rl.members import train_members  # it runs this function once per member
+
+        return train_members(config)
     run = Path(config.logger.out)
     run.mkdir(parents=True, exist_ok=True)
     ckpt_path = run / CHECKPOINT
@@ -127,11 +132,7 @@ def train(config: TrainConfig) -> Path:
     validator = None
     if config.validation.enabled:
         validator = LatticeValidator(config.env, config.validation, config.network)
-    if config.env.lattice.enabled or validator is not None:
-        tasks = lattice_tasks(config.env) if config.env.lattice.enabled else []
-        if validator is not None:
-            tasks += lattice_tasks(validation_env_config(config.env, config.validation))
-        run_tasks(tasks, config.executor)
+    render_lattices(config)
     best = resumed.get("validation") if resumed is not None else None  # {"frames", "score"} so far
 
     # Environment and collector (random actions until init_random_frames).
@@ -207,6 +208,15 @@ def train(config: TrainConfig) -> Path:
         writer.close()
         collector.shutdown()
     return ckpt_path
+
+
+def render_lattices(config: TrainConfig) -> None:
+    """Render the training (--lattice) and validation buildings' view lattices not cached yet, side by side
+    where the executor says, so envs and members then read the cache instead of each rendering them."""
+    tasks = lattice_tasks(config.env) if config.env.lattice.enabled else []
+    if config.validation.enabled:
+        tasks += lattice_tasks(validation_env_config(config.env, config.validation))
+    run_tasks(tasks, config.executor)
 
 
 def sac_update(loss_module: SACLoss, optim_actor: torch.optim.Optimizer, optim_critic: torch.optim.Optimizer,

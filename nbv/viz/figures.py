@@ -191,7 +191,7 @@ def plot_training_curves(runs: dict[str, str | Path], out: str | Path, window: i
         axes[-1].plot(frames[best], mean[best], "*", markersize=12, color=line.get_color())
     if validations:
         axes[-1].set(xlabel="frames (environment steps)", ylabel="visible coverage %",
-                     title="validation buildings (star: policy.pt)")
+                     title="validation buildings (star: a run's best)")
         axes[-1].grid(alpha=0.3)
     axes[0].legend(fontsize=8)
     return save_figure(fig, out)

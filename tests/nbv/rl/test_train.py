@@ -24,7 +24,7 @@ from scenes.spec import SceneSet
 
 TINY_ENV = ["--scene", "test_building", "--width", "64", "--height", "48", "--spp", "1", "--obs-size", "32",
             "--max-steps", "3", "--episode-views", "0", "--feature-backend", "opencv",
-            "--validation-scenes"]  # one-pass episodes of at most 3 steps, no validation
+            "--members", "1", "--validation-scenes"]  # one-pass episodes of <= 3 steps; one seed, unvalidated
 
 
 def tiny(out, frames: int, **collector) -> TrainConfig:

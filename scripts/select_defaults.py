@@ -57,7 +57,7 @@ Table 1, or learned), and the Bag of Views ranges split into two elevation bands
 together (`relative-bands2`, added once the first seeds of the others were scored). Measured before the
 lattice fix (a snapped viewpoint kept small relative steps from moving the camera); each run keeps its last
 actor."""
-BASE2 = ("--preset", "default", "--threads", "1", "--no-progress")
+BASE2 = ("--preset", "default", "--members", "1", "--threads", "1", "--no-progress")
 CANDIDATES2 = {
     "one-pass": ("--episode-views", "0"),
     "views13": ("--episode-views", "13"),
@@ -65,10 +65,10 @@ CANDIDATES2 = {
     "views13-step0.25": ("--episode-views", "13", "--relative-step", "0.25"),
 }
 """Round 2, after the lattice fix, flags over the default preset (`relative-bands2`, each checkpoint
-validated, `policy.pt` the best): episodes of one pass (the paper) or of 13 views (the evaluation's
-budget); then, after views13 was chosen and evaluated, orbit actions with 13-view episodes (absolute R and
-elevation: a start elevation cannot linger) and relative steps twice as long, against the seed spread
-views13 showed."""
+validated, `policy.pt` the best), one training seed per run (`--members 1`): episodes of one pass (the
+paper) or of 13 views (the evaluation's budget); then, after views13 was chosen and evaluated, orbit
+actions with 13-view episodes (absolute R and elevation: a start elevation cannot linger) and relative
+steps twice as long, against the seed spread views13 showed."""
 ROUNDS = {1: (BASE, CANDIDATES), 2: (BASE2, CANDIDATES2)}
 """`--round N`: the base command and candidates of each selection round."""
 

@@ -72,7 +72,8 @@ def test_train_flies_around_a_y_up_obj(tmp_path, monkeypatch):
     run = tmp_path / "run"
     args = ["train", "--scene", str(obj), "--up-axis", "y", *TINY, "--obs-size", "32", "--max-steps", "3",
             "--episode-views", "0", "--feature-backend", "opencv", "--frames", "2", "--frames-per-batch", "2",
-            "--init-random-frames", "2", "--validation-scenes", "--out", str(run), "--no-progress"]
+            "--init-random-frames", "2", "--members", "1", "--validation-scenes", "--out", str(run),
+            "--no-progress"]
     assert main(args) == 0
     assert load_checkpoint(run / "checkpoint.pt")["counters"]["frames"] == 2
     recorded = json.loads((run / "config.json").read_text())["env"]["scenes"]

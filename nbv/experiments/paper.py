@@ -256,6 +256,9 @@ INDEX = (
            "chalet", "nbv compare (command in the file)"),
     Result("selection/selection.md", "selection/selection.json", "choice of the default training settings "
            "on validation buildings", "scripts/select_defaults.py"),
+    Result("selection/members/README.md", "selection/members/selection.json", "the default command's "
+           "members (--seed 0, 1, 2) on a larger validation",
+           "scripts/select_defaults.py score --episodes 9"),
     Result("selection/round1/selection.md", "selection/round1/selection.json", "its first round, before the "
            "lattice fix", "scripts/select_defaults.py --round 1"),
 )

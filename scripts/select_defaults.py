@@ -69,7 +69,14 @@ validated, `policy.pt` the best), one training seed per run (`--members 1`): epi
 paper) or of 13 views (the evaluation's budget); then, after views13 was chosen and evaluated, orbit
 actions with 13-view episodes (absolute R and elevation: a start elevation cannot linger) and relative
 steps twice as long, against the seed spread views13 showed."""
-ROUNDS = {1: (BASE, CANDIDATES), 2: (BASE2, CANDIDATES2)}
+CANDIDATES3 = {
+    "batch32": ("--batch-size", "32", "--updates-per-frame", "0.3"),
+}
+"""Round 3, after the default's members were evaluated (paper_results/selection/members: two of nine
+seeds good), against the seed-to-seed variance itself, over round 2's base and views13: batches of 32
+instead of Table 1's 8 at a third of the gradient steps (3 per 10 frames: about the same compute, less
+gradient noise)."""
+ROUNDS = {1: (BASE, CANDIDATES), 2: (BASE2, CANDIDATES2), 3: (BASE2, CANDIDATES3)}
 """`--round N`: the base command and candidates of each selection round."""
 
 
@@ -169,7 +176,7 @@ def main() -> None:
     train.add_argument("--jobs", type=int, default=2)
     train.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
     train.add_argument("--round", type=int, default=2, choices=list(ROUNDS))
-    train.add_argument("--candidates", nargs="+", choices=[*CANDIDATES, *CANDIDATES2],
+    train.add_argument("--candidates", nargs="+", choices=[*CANDIDATES, *CANDIDATES2, *CANDIDATES3],
                        help="default: every candidate of the round")
     score = sub.add_parser("score")
     score.add_argument("--runs", type=Path, required=True)

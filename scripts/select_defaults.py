@@ -133,7 +133,7 @@ def score_all(args: argparse.Namespace) -> None:
         name, seed = run.name.rsplit("-seed", 1)
         planner = PolicyPlanner(run / "policy.pt")  # the actor the run chose (without validation: the last)
         env_config = planner.env_config
-        key = {"views": args.views, "episodes": args.episodes, "scenes": VALIDATION_SCENES,
+        key = {"views": args.views, "episodes": args.episodes, "scenes": list(VALIDATION_SCENES),
                "frames": json.loads((run / "config.json").read_text())["collector"]["frames"]}
         saved = run / "validation.json"  # a run's score, kept while the protocol and its budget hold
         if saved.is_file() and json.loads(saved.read_text())["key"] == key:

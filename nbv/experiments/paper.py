@@ -260,7 +260,7 @@ INDEX = (
            "members (--seed 0, 1, 2) on a larger validation",
            "scripts/select_defaults.py score --episodes 9"),
     Result("selection/round3/README.md", "selection/round3/selection.json", "its third round: batches "
-           "of 32", "scripts/select_defaults.py --round 3"),
+           "of 32, learning rate 2e-4", "scripts/select_defaults.py --round 3"),
     Result("selection/round1/selection.md", "selection/round1/selection.json", "its first round, before the "
            "lattice fix", "scripts/select_defaults.py --round 1"),
 )

@@ -43,11 +43,6 @@ def member_config(config: TrainConfig, member: int) -> TrainConfig:
                                   progress=config.logger.progress and config.executor.workers == 1))
 
 
-def train_member(config: TrainConfig) -> None:
-    """Train (or resume) one member run (a unit of work for the executor)."""
-    train(config)
-
-
 def train_members(config: TrainConfig) -> Path:
     """Train the command's members (lattices first, once) and keep the best-validated actor as
     `RUN/policy.pt`; return the kept member's checkpoint path."""
@@ -56,7 +51,7 @@ def train_members(config: TrainConfig) -> Path:
     write_json(run / "config.json", config_record(config))
     render_lattices(config)
     members = [member_config(config, k) for k in range(config.validation.members)]
-    tasks = [Task(f"member {k} (seed {m.collector.seed})", train_member, {"config": m})
+    tasks = [Task(f"member {k} (seed {m.collector.seed})", train, {"config": m})
              for k, m in enumerate(members)]
     with tqdm(total=len(tasks), unit="member", desc=f"train {run.name}",
               disable=not config.logger.progress) as bar:

@@ -43,7 +43,7 @@ FRAMES = 6000
 VALIDATION_SCENES = ("random:6", "random:7", "random:8")
 """Training-split buildings no run trains on: candidates and checkpoints are chosen on these."""
 MEMBERS = 3
-"""Training seeds of one default command, side by side (three 6000-frame runs took 11.3 min on 2 cores)."""
+"""Training seeds of one default command, side by side (three 6000-frame runs took 11-15 min on 2 cores)."""
 
 
 def paper_preset() -> TrainConfig:

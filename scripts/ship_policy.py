@@ -17,7 +17,7 @@ import shutil
 from pathlib import Path
 
 from common.io import write_json
-from nbv.rl.checkpoint import POLICY_FORMAT, checkpoint_config, load_checkpoint, save_policy
+from nbv.rl.checkpoint import copy_policy, load_policy
 from nbv.rl.members import MEMBERS_CSV
 
 
@@ -27,12 +27,10 @@ def main() -> None:
     parser.add_argument("--dest", type=Path, required=True)
     parser.add_argument("--name", default="runs/default")
     args = parser.parse_args()
-    state = load_checkpoint(args.run / "policy.pt", (POLICY_FORMAT,))
-    config = checkpoint_config(state, args.run / "policy.pt")
+    config, _ = load_policy(args.run / "policy.pt")
     config["logger"]["out"] = args.name
     args.dest.mkdir(parents=True, exist_ok=True)
-    save_policy(args.dest / "policy.pt", json.dumps(config),
-                {f"actor_network_params.{k}": v for k, v in state["actor"].items()}, state["counters"])
+    copy_policy(args.run / "policy.pt", args.dest / "policy.pt", config)
     write_json(args.dest / "config.json", config)
     shutil.copyfile(args.run / "training.png", args.dest / "training.png")
     if (args.run / MEMBERS_CSV).is_file():  # a run of several seeds: each one's logs in memberK/

@@ -101,6 +101,13 @@ def save_policy(path: str | Path, config: str, loss_state: dict[str, Any], count
                            POLICY_FORMAT)
 
 
+def copy_policy(source: str | Path, dest: str | Path, config: dict[str, Any]) -> Path:
+    """Write the actor and counters of the policy file `source` to `dest` under another run `config`."""
+    state = load_checkpoint(source, (POLICY_FORMAT,))
+    return save_checkpoint(dest, {"config": json.dumps(config), "actor": state["actor"],
+                                  "counters": state["counters"]}, POLICY_FORMAT)
+
+
 def actor_weights(loss_state: dict[str, Any]) -> dict[str, torch.Tensor]:
     """The actor's state dict out of a SAC loss module's state dict."""
     return {k[len(ACTOR_PREFIX):]: v for k, v in loss_state.items() if k.startswith(ACTOR_PREFIX)}

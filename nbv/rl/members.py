@@ -13,7 +13,6 @@ lists each member's best score and which one was kept; `training.png` overlays t
 from __future__ import annotations
 
 import csv
-import json
 from dataclasses import replace
 from pathlib import Path
 
@@ -24,9 +23,9 @@ from common.provenance import config_record
 from nbv.dist.config import ExecutorConfig
 from nbv.dist.executor import run_tasks
 from nbv.dist.task import Task
-from nbv.rl.checkpoint import ACTOR_PREFIX, POLICY_FORMAT, load_checkpoint, save_policy
+from nbv.rl.checkpoint import copy_policy
 from nbv.rl.config import TrainConfig
-from nbv.rl.train import CHECKPOINT, POLICY, render_lattices, train
+from nbv.rl.train import CHECKPOINT, POLICY, VALIDATION_CSV, render_lattices, train
 from nbv.viz.figures import plot_training_curves
 
 MEMBERS_CSV = "members.csv"
@@ -43,6 +42,15 @@ def member_config(config: TrainConfig, member: int) -> TrainConfig:
                                   progress=config.logger.progress and config.executor.workers == 1))
 
 
+def best_validation(path: Path) -> dict[str, float]:
+    """The {"frames", "score"} of the actor a run's `policy.pt` holds, from its validation.csv (the last
+    row names it) rather than from the checkpoint, which carries the whole replay buffer."""
+    with open(path, newline="") as file:
+        rows = list(csv.DictReader(file))
+    frames = int(rows[-1]["best_frames"])
+    return {"frames": frames, "score": next(float(r["mean"]) for r in rows if int(r["frames"]) == frames)}
+
+
 def train_members(config: TrainConfig) -> Path:
     """Train the command's members (lattices first, once) and keep the best-validated actor as
     `RUN/policy.pt`; return the kept member's checkpoint path."""
@@ -56,11 +64,9 @@ def train_members(config: TrainConfig) -> Path:
     with tqdm(total=len(tasks), unit="member", desc=f"train {run.name}",
               disable=not config.logger.progress) as bar:
         run_tasks(tasks, config.executor, on_done=lambda task: bar.update())
-    best = [load_checkpoint(Path(m.logger.out) / CHECKPOINT)["validation"] for m in members]
+    best = [best_validation(Path(m.logger.out) / VALIDATION_CSV) for m in members]
     kept = max(range(len(members)), key=lambda k: (best[k]["score"], -k))  # ties: the lower seed
-    policy = load_checkpoint(Path(members[kept].logger.out) / POLICY, (POLICY_FORMAT,))
-    save_policy(run / POLICY, json.dumps(config_record(config)),
-                {f"{ACTOR_PREFIX}{k}": v for k, v in policy["actor"].items()}, policy["counters"])
+    copy_policy(Path(members[kept].logger.out) / POLICY, run / POLICY, config_record(config))
     with open(run / MEMBERS_CSV, "w", newline="") as file:
         log = csv.writer(file)
         log.writerow(["member", "seed", "best_frames", "best_score", "kept"])

@@ -78,7 +78,17 @@ seeds good), against the seed-to-seed variance itself, over round 2's base and v
 instead of Table 1's 8 at a third of the gradient steps (3 per 10 frames: about the same compute, less
 gradient noise); then, as batch32 and the default both peaked and fell back, a learning rate of 2e-4
 instead of 5e-4."""
-ROUNDS = {1: (BASE, CANDIDATES), 2: (BASE2, CANDIDATES2), 3: (BASE2, CANDIDATES3)}
+CANDIDATES4 = {
+    "cov100": ("--coverage-reward", "100"),
+    "cov300": ("--coverage-reward", "300"),
+}
+"""Round 4, after round 3 and a look at the members' modes (each flies one helix at the largest azimuth
+step; the seeds differ in where R and elevation drift, which the Bag of Views reward ignores), over
+round 2's base and views13: a geometric term added to the reward (`--coverage-reward W`: W x the share
+of the true surface a view is the episode's first to see; beyond the paper), at two weights. An
+episode's Bag of Views return is about 105-130 and its coverage about 0.8, so W = 100 adds a term of
+about the same size and W = 300 one that dominates."""
+ROUNDS = {1: (BASE, CANDIDATES), 2: (BASE2, CANDIDATES2), 3: (BASE2, CANDIDATES3), 4: (BASE2, CANDIDATES4)}
 """`--round N`: the base command and candidates of each selection round."""
 
 
@@ -178,7 +188,8 @@ def main() -> None:
     train.add_argument("--jobs", type=int, default=2)
     train.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
     train.add_argument("--round", type=int, default=2, choices=list(ROUNDS))
-    train.add_argument("--candidates", nargs="+", choices=[*CANDIDATES, *CANDIDATES2, *CANDIDATES3],
+    train.add_argument("--candidates", nargs="+",
+                       choices=[name for _, names in ROUNDS.values() for name in names],
                        help="default: every candidate of the round")
     score = sub.add_parser("score")
     score.add_argument("--runs", type=Path, required=True)

@@ -112,13 +112,15 @@ def planning_env_config(config: PlanConfig, planner: Planner) -> EnvConfig:
     """The env the planner works in: a policy's training settings on this scene, else `scan_env_config`.
 
     Planning always renders exact viewpoints: a policy trained on a view lattice plans without it. Its
-    episode ends where the protocol says (one pass, or the view budget), whatever budget it trained with.
+    episode ends where the protocol says (one pass, or the view budget), whatever budget it trained with,
+    and no reward reads the true mesh.
     """
     own = scan_env_config(config)
     if isinstance(planner, PolicyPlanner):
         trained = planner.env_config
         render = replace(trained.render, variant=config.render.variant)
-        return replace(trained, scenes=own.scenes, render=render, lattice=LatticeConfig(), episode_views=0)
+        return replace(trained, scenes=own.scenes, render=render, lattice=LatticeConfig(), episode_views=0,
+                       coverage_reward=0.0)
     return own
 
 

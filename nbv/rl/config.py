@@ -86,6 +86,10 @@ class EnvConfig:
     relative_step: float = 0.25
     """Relative and orbit modes: the largest step per action, as a fraction of each range (azimuth: of
     2 pi)."""
+    coverage_reward: float = 0.0
+    """Weight W of a geometric reward term, beyond the paper: W x the share of the target's surface
+    samples that the new view is the first of its episode to see (ground truth, so training only).
+    0: the Bag of Views reward alone (the paper)."""
 
     def __post_init__(self) -> None:
         if not 0 < self.radius_min <= self.radius_max:
@@ -103,6 +107,8 @@ class EnvConfig:
                              f"{self.max_steps + 1}], got {self.episode_views}")
         if not 0 < self.relative_step <= 1:
             raise ValueError(f"relative_step must lie in (0, 1], got {self.relative_step}")
+        if not 0 <= self.coverage_reward < math.inf:
+            raise ValueError(f"coverage_reward must be finite and >= 0, got {self.coverage_reward}")
 
     @property
     def low(self) -> np.ndarray:

@@ -23,6 +23,10 @@ docs/bov.md), from the config's `bov` (its match cosine included; with
 `elevation_bands` E > 1 each azimuth range is split into E bands over the
 allowed elevations, beyond the paper). The BoV is
 emptied at each reset and learns the episode's first view without reward.
+With `coverage_reward` W > 0 (beyond the paper, training only: it reads the
+true mesh) the reward adds W x the share of the target's surface samples
+(`nbv.recon.visibility`) that the new view is the episode's first to see; on
+a lattice that is the node's view, as the frame is.
 
 Termination: one pass around the target, i.e. the net azimuth travelled
 (each step's change wrapped to (-pi, pi]) reaches 2 pi in either direction;
@@ -65,6 +69,7 @@ from torchrl.envs import EnvBase
 from common.threads import apply_thread_policy
 from nbv.bov.bag import BagOfViews
 from nbv.features.sift import extract_features
+from nbv.recon.visibility import SurfaceVisibility, scene_visibility
 from nbv.rl.config import EnvConfig
 from nbv.rl.lattice import ViewLattice, build_lattice
 from render.renderer import MitsubaRenderer
@@ -154,6 +159,9 @@ class NBVEnv(EnvBase):
         self._renderers: dict[str, MitsubaRenderer] = {}
         self._lattices: dict[str, ViewLattice] = {}
         self._loaded: dict[str, Scene] = {}
+        self._visibility: dict[str, SurfaceVisibility] = {}
+        self._node_seen: dict[tuple[str, int], np.ndarray] = {}
+        self._seen: np.ndarray | None = None  # the episode's seen surface samples (coverage reward)
         self._features = config.bov.feature_config()
         self._bov: BagOfViews | None = None
         self._resume_pending = False
@@ -187,6 +195,8 @@ class NBVEnv(EnvBase):
         self.bov.reset()
         frame, descriptors = self.capture(self._view)
         self.bov.update(descriptors, self._view.azimuth, self._view.elevation)
+        if self.config.coverage_reward:
+            self._seen = self.surface_seen(self._view)
         location = normalise_viewpoint(self._view, self.config)
         self._frames = np.repeat(frame[None], self.config.history, axis=0)
         self._locations = np.repeat(location[None], self.config.history, axis=0)
@@ -198,6 +208,10 @@ class NBVEnv(EnvBase):
         view = action_to_viewpoint(tensordict["action"], self._view, self.config)
         frame, descriptors = self.capture(view)
         reward = self.bov.reward(descriptors, view.azimuth, view.elevation)
+        if self.config.coverage_reward:
+            seen = self.surface_seen(view)
+            reward += self.config.coverage_reward * float((seen & ~self._seen).mean())
+            self._seen |= seen
         self._progress += wrap_angle(view.azimuth - self._view.azimuth)
         self._view = view
         self._steps += 1
@@ -254,6 +268,7 @@ class NBVEnv(EnvBase):
             "view": self._view.as_array().tolist(), "frames": torch.from_numpy(self._frames.copy()),
             "locations": torch.from_numpy(self._locations.copy()),
             "progress": self._progress, "steps": self._steps, "bov": self.bov.state_dict(),
+            **({"seen": torch.from_numpy(self._seen.copy())} if self._seen is not None else {}),
         }
 
     def restore(self, state: dict[str, Any]) -> None:
@@ -266,6 +281,7 @@ class NBVEnv(EnvBase):
         self._frames, self._locations = state["frames"].numpy().copy(), state["locations"].numpy().copy()
         self._progress, self._steps = float(state["progress"]), int(state["steps"])
         self.bov.load_state_dict(state["bov"])
+        self._seen = state["seen"].numpy().copy() if "seen" in state else None
         self._resume_pending = True
 
     # -- rendering -----------------------------------------------------------------------------
@@ -302,6 +318,19 @@ class NBVEnv(EnvBase):
         rgb = self.render_view(view)
         descriptors = torch.as_tensor(extract_features([rgb], self._features)[0].descriptors)
         return gray_frame(rgb, self.config.obs_size), descriptors
+
+    def surface_seen(self, view: Viewpoint) -> np.ndarray:
+        """Which of the current target's surface samples `view` sees (with a lattice: its node does)."""
+        scene = self._scene.scene
+        if scene not in self._visibility:
+            self._visibility[scene] = scene_visibility(self.scene, self.config.camera)
+        visibility = self._visibility[scene]
+        if not self.config.lattice.enabled:
+            return visibility.seen(viewpoint_to_c2w(view, self.scene.center()))
+        node, index = self._lattice(self._scene).snap(view)
+        if (scene, index) not in self._node_seen:
+            self._node_seen[scene, index] = visibility.seen(viewpoint_to_c2w(node, self.scene.center()))
+        return self._node_seen[scene, index]
 
     def _renderer(self, spec: SceneSpec) -> MitsubaRenderer:
         if spec.scene not in self._renderers:

@@ -27,9 +27,10 @@ from scenes.spec import SceneSet
 
 
 def validation_env_config(env: EnvConfig, validation: ValidationConfig) -> EnvConfig:
-    """The training env on the validation buildings, on view lattices (the training lattice settings)."""
+    """The training env on the validation buildings, on view lattices (the training lattice settings),
+    without the coverage reward (its score is the coverage)."""
     scenes = SceneSet(scene=validation.validation_scenes, up_axis=env.scenes.up_axis)
-    return replace(env, scenes=scenes, lattice=replace(env.lattice, enabled=True))
+    return replace(env, scenes=scenes, lattice=replace(env.lattice, enabled=True), coverage_reward=0.0)
 
 
 class LatticeValidator:

@@ -71,8 +71,9 @@ from nbv.bov.bag import BagOfViews
 from nbv.features.sift import extract_features
 from nbv.recon.visibility import SurfaceVisibility, scene_visibility
 from nbv.rl.config import EnvConfig
-from nbv.rl.lattice import ViewLattice, build_lattice
+from nbv.rl.lattice import ViewLattice, build_lattice, lattice_path, read_lattice
 from render.renderer import MitsubaRenderer
+from render.variant import select_variant
 from render.viewpoint import TWO_PI, Viewpoint, viewpoint_to_c2w
 from scenes.model import Scene
 from scenes.spec import SceneSpec
@@ -345,10 +346,14 @@ class NBVEnv(EnvBase):
         return self._loaded[spec.scene]
 
     def _lattice(self, spec: SceneSpec) -> ViewLattice:
+        """The scene's lattice: read from the cache without a renderer, or rendered now."""
         if spec.scene not in self._lattices:
-            renderer = self._renderer(spec)
-            self._lattices[spec.scene] = build_lattice(self._load(spec), renderer, self.config,
-                                                       self._features, progress=False)
+            scene = self._load(spec)
+            variant = select_variant(self._render.variant).variant()
+            path = lattice_path(scene, self.config, self._features, variant)
+            self._lattices[spec.scene] = (read_lattice(path, self.config) if path.is_file() else
+                                          build_lattice(scene, self._renderer(spec), self.config,
+                                                        self._features, progress=False))
         return self._lattices[spec.scene]
 
     def _observation(self, terminated: bool = False, truncated: bool = False) -> TensorDict:

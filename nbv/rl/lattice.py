@@ -102,6 +102,13 @@ def lattice_path(scene: Scene, config: EnvConfig, features: FeatureConfig, varia
     return cache_dir() / "lattice" / f"{lattice_key(scene, config, features, variant)}.pt"
 
 
+def read_lattice(path: Path, config: EnvConfig) -> ViewLattice:
+    """A cached lattice (`lattice_path`) of the config's axes."""
+    doc = torch.load(path, weights_only=True)
+    return ViewLattice(doc["frames"].numpy(), doc["counts"].numpy(), doc["descriptors"].float(),
+                       lattice_axes(config))
+
+
 def build_lattice(scene: Scene, renderer: MitsubaRenderer, config: EnvConfig, features: FeatureConfig,
                   progress: bool = True) -> ViewLattice:
     """The scene's lattice, read from the cache or rendered now (node i with render seed i) and cached."""
@@ -110,8 +117,7 @@ def build_lattice(scene: Scene, renderer: MitsubaRenderer, config: EnvConfig, fe
     axes = lattice_axes(config)
     path = lattice_path(scene, config, features, renderer.variant)
     if path.is_file():
-        doc = torch.load(path, weights_only=True)
-        return ViewLattice(doc["frames"].numpy(), doc["counts"].numpy(), doc["descriptors"].float(), axes)
+        return read_lattice(path, config)
     nodes = [Viewpoint(float(r), float(a), float(e)) for r in axes[0] for a in axes[1] for e in axes[2]]
     frames, descriptors = [], []
     for i, node in enumerate(tqdm(nodes, desc=f"lattice {scene.name}", unit="view", disable=not progress)):

@@ -156,14 +156,14 @@ def score_all(args: argparse.Namespace) -> None:
         scores.setdefault(name, {})[int(seed)] = score
     baselines = {name: validation_score(make_planner(name, seed=0), env_config, args.views, args.episodes)
                  for name in ("random", "circle")}
-    rows = [[name, len(by_seed), *(f"{by_seed[s]:.1f}" for s in sorted(by_seed)),
+    seeds = sorted({seed for by_seed in scores.values() for seed in by_seed})
+    rows = [[name, len(by_seed), *(f"{by_seed[s]:.1f}" if s in by_seed else "-" for s in seeds),
              f"{np.mean(list(by_seed.values())):.1f} ± {np.std(list(by_seed.values())):.1f}"]
             for name, by_seed in sorted(scores.items(), key=lambda kv: -np.mean(list(kv[1].values())))]
-    seeds = max(len(v) for v in scores.values())
     table = (f"Visible-surface coverage (%) of the true mesh, policy mode, {args.views} views, validation "
              f"buildings {', '.join(VALIDATION_SCENES)} x {args.episodes} start views; "
              + ", ".join(f"{k} {v:.1f}" for k, v in baselines.items()) + "\n\n"
-             + markdown_table(["candidate", "seeds", *(f"seed {i}" for i in range(seeds)), "mean ± std"],
+             + markdown_table(["candidate", "seeds", *(f"seed {i}" for i in seeds), "mean ± std"],
                               rows))
     outputs = ("selection.json", "selection.md", "selection.png")
     with atomic_folder(args.out, overwrite=True, outputs=outputs) as out:

@@ -58,6 +58,8 @@ together (`relative-bands2`, added once the first seeds of the others were score
 lattice fix (a snapped viewpoint kept small relative steps from moving the camera); each run keeps its last
 actor."""
 BASE2 = ("--preset", "default", "--members", "1", "--threads", "1", "--no-progress")
+BASE_BOV = (*BASE2, "--coverage-reward", "0")
+"""Rounds 2 and 3 ran before the default had a coverage term: the default preset without it."""
 CANDIDATES2 = {
     "one-pass": ("--episode-views", "0"),
     "views13": ("--episode-views", "13"),
@@ -88,7 +90,8 @@ round 2's base and views13: a geometric term added to the reward (`--coverage-re
 of the true surface a view is the episode's first to see; beyond the paper), at two weights. An
 episode's Bag of Views return is about 105-130 and its coverage about 0.8, so W = 100 adds a term of
 about the same size and W = 300 one that dominates."""
-ROUNDS = {1: (BASE, CANDIDATES), 2: (BASE2, CANDIDATES2), 3: (BASE2, CANDIDATES3), 4: (BASE2, CANDIDATES4)}
+ROUNDS = {1: (BASE, CANDIDATES), 2: (BASE_BOV, CANDIDATES2), 3: (BASE_BOV, CANDIDATES3),
+          4: (BASE2, CANDIDATES4)}
 """`--round N`: the base command and candidates of each selection round."""
 
 

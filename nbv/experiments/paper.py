@@ -261,6 +261,8 @@ INDEX = (
            "scripts/select_defaults.py score --episodes 9"),
     Result("selection/round3/README.md", "selection/round3/selection.json", "its third round: batches "
            "of 32, learning rate 2e-4", "scripts/select_defaults.py --round 3"),
+    Result("selection/round4/README.md", "selection/round4/selection.json", "its fourth round: a coverage "
+           "term in the reward", "scripts/select_defaults.py --round 4"),
     Result("selection/round1/selection.md", "selection/round1/selection.json", "its first round, before the "
            "lattice fix", "scripts/select_defaults.py --round 1"),
 )

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 import pytest
 import torch
 from tensordict import TensorDict
@@ -117,8 +116,9 @@ def test_bad_weights_are_refused(weight):
 
 def test_the_command_line_sets_the_weight():
     from nbv.cli.train import parse_train
+    from nbv.rl.presets import COVERAGE_REWARD
 
-    cfg = parse_train(["--coverage-reward", "100", "--out", "run"])
-    assert cfg.env.coverage_reward == 100.0
-    assert parse_train(["--out", "run"]).env.coverage_reward == 0.0
-    assert np.isclose(parse_train(["--preset", "paper", "--out", "run"]).env.coverage_reward, 0.0)
+    assert parse_train(["--coverage-reward", "300", "--out", "run"]).env.coverage_reward == 300.0
+    assert parse_train(["--out", "run"]).env.coverage_reward == COVERAGE_REWARD == 100.0
+    assert parse_train(["--preset", "paper", "--out", "run"]).env.coverage_reward == 0.0
+    assert parse_train(["--coverage-reward", "0", "--out", "run"]).env.coverage_reward == 0.0

@@ -191,8 +191,9 @@ def test_match_cosine_reaches_the_reward():
     assert rewards[0.5] != pytest.approx(rewards[0.8], abs=1e-3)
 
 
-def test_snapshot_restore_continues_the_episode():
-    config = tiny_config(max_steps=6)
+@pytest.mark.parametrize("coverage_reward", [0.0, 30.0])  # with the coverage term: what was seen, too
+def test_snapshot_restore_continues_the_episode(coverage_reward):
+    config = tiny_config(max_steps=6, coverage_reward=coverage_reward)
     a = NBVEnv(config, seed=5)
     td = a.reset()
     td = a.step(td.set("action", torch.tensor([0.2, 0.4, -0.1])))["next"]

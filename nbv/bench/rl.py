@@ -92,7 +92,7 @@ def lattice_vs_render(config: EnvConfig, steps: int) -> list[BenchResult]:
     renderer = MitsubaRenderer(scene, on_lattice.camera, on_lattice.render)
     with temporary_cache():
         start = time.perf_counter()
-        build_lattice(scene, renderer, on_lattice, on_lattice.bov.feature_config(), progress=False)
+        build_lattice(scene, lambda: renderer, on_lattice, on_lattice.bov.feature_config(), progress=False)
         build = time.perf_counter() - start
         snapping = env_steps_per_s(on_lattice, 1, 10 * steps)
     nodes = on_lattice.lattice.lattice_radii * on_lattice.lattice.lattice_azimuths

@@ -71,9 +71,8 @@ from nbv.bov.bag import BagOfViews
 from nbv.features.sift import extract_features
 from nbv.recon.visibility import SurfaceVisibility, scene_visibility
 from nbv.rl.config import EnvConfig
-from nbv.rl.lattice import ViewLattice, build_lattice, lattice_path, read_lattice
+from nbv.rl.lattice import ViewLattice, build_lattice
 from render.renderer import MitsubaRenderer
-from render.variant import select_variant
 from render.viewpoint import TWO_PI, Viewpoint, viewpoint_to_c2w
 from scenes.model import Scene
 from scenes.spec import SceneSpec
@@ -160,7 +159,7 @@ class NBVEnv(EnvBase):
         self._renderers: dict[str, MitsubaRenderer] = {}
         self._lattices: dict[str, ViewLattice] = {}
         self._loaded: dict[str, Scene] = {}
-        self._visibility: dict[str, SurfaceVisibility] = {}
+        self._visibility: dict[str, tuple[SurfaceVisibility, np.ndarray]] = {}  # with the scene centre
         self._node_seen: dict[tuple[str, int], np.ndarray] = {}
         self._seen: np.ndarray | None = None  # the episode's seen surface samples (coverage reward)
         self._features = config.bov.feature_config()
@@ -324,13 +323,13 @@ class NBVEnv(EnvBase):
         """Which of the current target's surface samples `view` sees (with a lattice: its node does)."""
         scene = self._scene.scene
         if scene not in self._visibility:
-            self._visibility[scene] = scene_visibility(self.scene, self.config.camera)
-        visibility = self._visibility[scene]
+            self._visibility[scene] = scene_visibility(self.scene, self.config.camera), self.scene.center()
+        visibility, center = self._visibility[scene]
         if not self.config.lattice.enabled:
-            return visibility.seen(viewpoint_to_c2w(view, self.scene.center()))
+            return visibility.seen(viewpoint_to_c2w(view, center))
         node, index = self._lattice(self._scene).snap(view)
         if (scene, index) not in self._node_seen:
-            self._node_seen[scene, index] = visibility.seen(viewpoint_to_c2w(node, self.scene.center()))
+            self._node_seen[scene, index] = visibility.seen(viewpoint_to_c2w(node, center))
         return self._node_seen[scene, index]
 
     def _renderer(self, spec: SceneSpec) -> MitsubaRenderer:
@@ -348,12 +347,8 @@ class NBVEnv(EnvBase):
     def _lattice(self, spec: SceneSpec) -> ViewLattice:
         """The scene's lattice: read from the cache without a renderer, or rendered now."""
         if spec.scene not in self._lattices:
-            scene = self._load(spec)
-            variant = select_variant(self._render.variant).variant()
-            path = lattice_path(scene, self.config, self._features, variant)
-            self._lattices[spec.scene] = (read_lattice(path, self.config) if path.is_file() else
-                                          build_lattice(scene, self._renderer(spec), self.config,
-                                                        self._features, progress=False))
+            self._lattices[spec.scene] = build_lattice(self._load(spec), lambda: self._renderer(spec),
+                                                       self.config, self._features, progress=False)
         return self._lattices[spec.scene]
 
     def _observation(self, terminated: bool = False, truncated: bool = False) -> TensorDict:

@@ -19,6 +19,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
 
@@ -102,22 +103,18 @@ def lattice_path(scene: Scene, config: EnvConfig, features: FeatureConfig, varia
     return cache_dir() / "lattice" / f"{lattice_key(scene, config, features, variant)}.pt"
 
 
-def read_lattice(path: Path, config: EnvConfig) -> ViewLattice:
-    """A cached lattice (`lattice_path`) of the config's axes."""
-    doc = torch.load(path, weights_only=True)
-    return ViewLattice(doc["frames"].numpy(), doc["counts"].numpy(), doc["descriptors"].float(),
-                       lattice_axes(config))
-
-
-def build_lattice(scene: Scene, renderer: MitsubaRenderer, config: EnvConfig, features: FeatureConfig,
-                  progress: bool = True) -> ViewLattice:
-    """The scene's lattice, read from the cache or rendered now (node i with render seed i) and cached."""
+def build_lattice(scene: Scene, make_renderer: Callable[[], MitsubaRenderer], config: EnvConfig,
+                  features: FeatureConfig, progress: bool = True) -> ViewLattice:
+    """The scene's lattice, read from the cache, or rendered now (node i with render seed i) by the
+    renderer `make_renderer` gives (asked for only then: its variant is `config.render`'s) and cached."""
     from nbv.rl.env import gray_frame
 
     axes = lattice_axes(config)
-    path = lattice_path(scene, config, features, renderer.variant)
+    path = lattice_path(scene, config, features, select_variant(config.render.variant).variant())
     if path.is_file():
-        return read_lattice(path, config)
+        doc = torch.load(path, weights_only=True)
+        return ViewLattice(doc["frames"].numpy(), doc["counts"].numpy(), doc["descriptors"].float(), axes)
+    renderer = make_renderer()
     nodes = [Viewpoint(float(r), float(a), float(e)) for r in axes[0] for a in axes[1] for e in axes[2]]
     frames, descriptors = [], []
     for i, node in enumerate(tqdm(nodes, desc=f"lattice {scene.name}", unit="view", disable=not progress)):
@@ -136,7 +133,7 @@ def build_lattice(scene: Scene, renderer: MitsubaRenderer, config: EnvConfig, fe
 def render_lattice(config: EnvConfig, scene: SceneSpec) -> None:
     """Render one scene's lattice into the cache (a unit of work: `lattice_tasks`)."""
     loaded = scene.load()
-    build_lattice(loaded, MitsubaRenderer(loaded, config.camera, config.render), config,
+    build_lattice(loaded, lambda: MitsubaRenderer(loaded, config.camera, config.render), config,
                   config.bov.feature_config(), progress=False)
 
 

@@ -153,14 +153,22 @@ def test_unknown_scene_is_a_clear_cli_error(tmp_path, capsys):
 
 def test_training_on_a_lattice_renders_it_first_on_the_workers(tmp_path, monkeypatch):
     import nbv.rl.env
+    from nbv.rl.lattice import lattice_path
+    from render.variant import select_variant
 
     monkeypatch.setenv("NBV_CACHE_DIR", str(tmp_path / "cache"))  # spawned workers inherit it
+    original = nbv.rl.env.build_lattice
+
+    def cached_already(scene, make_renderer, config, features, progress=True):
+        variant = select_variant(config.render.variant).variant()
+        assert lattice_path(scene, config, features, variant).is_file()  # the env only reads it
+        return original(scene, make_renderer, config, features, progress)
 
     def rendered(*args, **kwargs):
-        pytest.fail("the training env built a lattice or a renderer: the workers had cached it")
+        pytest.fail("the training env built a renderer: the workers had cached the lattice")
 
-    monkeypatch.setattr(nbv.rl.env, "build_lattice", rendered)  # the env only reads the cache,
-    monkeypatch.setattr(nbv.rl.env, "MitsubaRenderer", rendered)  # with no renderer
+    monkeypatch.setattr(nbv.rl.env, "build_lattice", cached_already)
+    monkeypatch.setattr(nbv.rl.env, "MitsubaRenderer", rendered)  # no renderer, so nothing rendered
     args = ["train", *TINY_ENV, "--lattice", "--lattice-radii", "1", "--lattice-azimuths", "4",
             "--lattice-elevations", "2", "--frames", "2", "--frames-per-batch", "2", "--init-random-frames",
             "2", "--workers", "2", "--out", str(tmp_path / "run"), "--no-progress"]

@@ -1,7 +1,7 @@
 """Next-best-view planning: features, Bag of Views, refinement, RL, reconstruction, metrics.
 
 Subpackages, one concern each: `features`, `bov`, `recon`, `rl`, `planning`,
-`experiments`, `viz`, `bench`, `cli`. The main names are re-exported lazily.
+`experiments`, `viz`, `fanout`, `bench`, `cli`. The main names are re-exported lazily.
 """
 
 from common.lazy import lazy_exports

@@ -4,7 +4,7 @@ Table 2 + rendering ablations + planner comparison (`nbv online`) on N nodes of 
 The per-run planning times come from `paper_results/online/online.json` and the Table 2 time from
 `paper_results/table2.json` (both measured on our 2-core machine); the other costs are measured
 figures passed as options (their defaults: what we measured, see the options' help). The prediction is
-`nbv.dist.capacity.schedule_wall_s`: one core per unit, longest first.
+`nbv.fanout.capacity.schedule_wall_s`: one core per unit, longest first.
 
     python scripts/capacity_plan.py --efficiency 0.9 --out docs/capacity.md
 """
@@ -17,7 +17,7 @@ from pathlib import Path
 
 from common.io import markdown_table, write_text
 from common.provenance import git_commit
-from nbv.dist.capacity import schedule_wall_s
+from nbv.fanout.capacity import schedule_wall_s
 
 NODES = (1, 2, 4, 8)
 CORES = (2, 16, 64)
@@ -132,12 +132,12 @@ COMMAND = ("python scripts/capacity_plan.py --plan-fixed-s {args.plan_fixed_s:g}
            "--bench {args.bench} --out docs/capacity.md")
 TEMPLATE = """# Capacity plan: the paper's experiments beyond one machine
 
-Written by `{command}` at commit {commit}; the schedule is `nbv.dist.capacity.schedule_wall_s`.
+Written by `{command}` at commit {commit}; the schedule is `nbv.fanout.capacity.schedule_wall_s`.
 
 ## Units of work and what one costs
 
 Every experiment splits into units that are pure functions of their settings and write their own
-files (`nbv.dist`, docs/architecture.md §6). Each runs on one core (its Dr.Jit and torch threads
+files (`nbv.fanout`, docs/architecture.md §6). Each runs on one core (its Dr.Jit and torch threads
 capped), so N nodes of M cores run N x M units at once.
 
 {costs}

@@ -1,4 +1,4 @@
-"""Fan-out figures (`nbv.dist`): the same units of work in this process, on 1 and 2 local workers, on Ray.
+"""Fan-out figures (`nbv.fanout`): the same units of work in this process, on 1 and 2 local workers, on Ray.
 
 The units are `nbv compare`'s plan runs (random and circle planners x seeds) on
 the test building at 160x120, 4 spp, 8 views, scored against the ground-truth
@@ -25,10 +25,10 @@ from collections.abc import Callable
 from pathlib import Path
 
 from nbv.bench import BenchResult
-from nbv.dist.config import ExecutorConfig
-from nbv.dist.executor import run_stages
-from nbv.dist.processes import run_in_processes
-from nbv.dist.task import Task
+from nbv.fanout.config import ExecutorConfig
+from nbv.fanout.executor import run_stages
+from nbv.fanout.processes import run_in_processes
+from nbv.fanout.task import Task
 from nbv.experiments.compare import CompareConfig, comparison_tasks
 from nbv.recon.config import MetricsConfig, ReconstructionConfig
 from render.camera import UAVCamera

@@ -11,7 +11,7 @@ import importlib
 import sys
 from typing import NamedTuple
 
-from nbv.dist.task import WorkerDied
+from nbv.fanout.task import WorkerDied
 
 
 class Command(NamedTuple):

@@ -17,7 +17,7 @@ measures, against the reference render settings (`ablation_axes`):
   at 13 views, its coverage of the true surface.
 Each unit writes its own JSON atomically into a cache folder keyed by the
 settings and the commit, so an interrupted run resumes and a new commit
-measures afresh, and runs where `--workers` / `--ray` say (`nbv.dist`);
+measures afresh, and runs where `--workers` / `--ray` say (`nbv.fanout`);
 `run_ablations` then writes the tables, plots and README
 (`nbv.experiments.ablation_report`) onto `--out` together.
 """
@@ -41,9 +41,9 @@ from common.io import atomic_path, cache_dir, write_json
 from common.provenance import git_commit, run_cache
 from common.threads import apply_thread_policy
 from nbv.bov.config import BoVConfig
-from nbv.dist.config import ExecutorConfig
-from nbv.dist.executor import run_tasks
-from nbv.dist.task import Task
+from nbv.fanout.config import ExecutorConfig
+from nbv.fanout.executor import run_tasks
+from nbv.fanout.task import Task
 from nbv.experiments.ablation_axes import AXES, REFERENCE, Level, apply_level, check_axes
 from nbv.recon.config import MetricsConfig, ReconstructionConfig
 from render.camera import UAVCamera

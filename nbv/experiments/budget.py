@@ -8,7 +8,7 @@ views to better the whole set, so they plan afresh at every budget. Runs are
 `nbv plan` folders scored against the ground truth only (no full scan), kept in
 a cache folder keyed by the settings and the commit (an interrupted run
 resumes; a new commit measures afresh). Each plan, then each plan's prefix
-scoring, is a unit of work (`nbv.dist`), so `--workers` / `--ray` spread them.
+scoring, is a unit of work (`nbv.fanout`), so `--workers` / `--ray` spread them.
 The area under each curve is the mean coverage over the budget range
 (trapezoid rule, `coverage_auc`).
 """
@@ -24,9 +24,9 @@ import numpy as np
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import config_record, git_commit, run_cache
-from nbv.dist.config import ExecutorConfig
-from nbv.dist.executor import run_stages
-from nbv.dist.task import Task
+from nbv.fanout.config import ExecutorConfig
+from nbv.fanout.executor import run_stages
+from nbv.fanout.task import Task
 from nbv.experiments.online import scene_folder
 from nbv.planning.plan import PlanSettings, plan_scan
 from nbv.planning.planners import planner_label

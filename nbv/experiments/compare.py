@@ -11,7 +11,7 @@ over seeds (docs/rl.md §10). Example (paper_results/planners):
 Each run is its own `nbv plan` output folder, written atomically as it finishes
 (an interrupted comparison keeps the runs done). The runs are independent units
 (`comparison_tasks`): `--workers N` runs them on N local processes, `--ray auto`
-or `--ray ADDRESS` on Ray (`nbv.dist`), with the same files and numbers as in
+or `--ray ADDRESS` on Ray (`nbv.fanout`), with the same files and numbers as in
 this process. The full-scan reference of the scene is made first, once, so the
 runs never render it side by side. The comparison files
 (`OUTPUTS`) are swapped onto `--out` together at the end (`common.io.atomic_folder`),
@@ -28,9 +28,9 @@ import numpy as np
 
 from common.io import atomic_folder, write_json, write_text
 from common.provenance import config_record, git_commit
-from nbv.dist.config import ExecutorConfig
-from nbv.dist.executor import run_stages
-from nbv.dist.task import Task
+from nbv.fanout.config import ExecutorConfig
+from nbv.fanout.executor import run_stages
+from nbv.fanout.task import Task
 from nbv.experiments.paper_numbers import FIG1_NBV
 from nbv.planning.plan import PlanSettings, plan_scan, reference_mesh
 from nbv.planning.planners import planner_label

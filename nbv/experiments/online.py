@@ -12,7 +12,7 @@ over greedy (issue 11's acceptance figures), then the one-pass table. The buildi
 the held-out ones: nothing here trains or tunes anything.
 
 Every (planner, seed, building, protocol) run is an independent unit: all of them are handed to the
-executor at once (`--workers N`, `--ray auto|ADDRESS`; `nbv.dist`), after each building's full-scan
+executor at once (`--workers N`, `--ray auto|ADDRESS`; `nbv.fanout`), after each building's full-scan
 reference, so the buildings run side by side as well as the seeds.
 """
 
@@ -26,8 +26,8 @@ import numpy as np
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import config_record, git_commit
-from nbv.dist.config import ExecutorConfig
-from nbv.dist.executor import run_stages
+from nbv.fanout.config import ExecutorConfig
+from nbv.fanout.executor import run_stages
 from nbv.experiments.compare import CompareConfig, compare_planners, comparison_tasks
 from nbv.experiments.paper_numbers import FIG1_NBV, FIG7_GENERALISATION
 from nbv.planning.planners import planner_label

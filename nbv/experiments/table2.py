@@ -10,7 +10,7 @@ labelled columns.
 
 Each building is a unit of work (`measure_scene_unit`: its rows and heat maps,
 written atomically into a scratch folder beside `--out`), so `--workers N` or
-`--ray auto|ADDRESS` measure the buildings side by side (`nbv.dist`; on a
+`--ray auto|ADDRESS` measure the buildings side by side (`nbv.fanout`; on a
 cluster the scratch folder must be shared). At the end
 the tables, the chart and `fig6/` (`OUTPUTS`) are swapped onto `--out` together
 (`common.io.atomic_folder`): an interrupted run keeps the previous results whole,
@@ -34,9 +34,9 @@ from common.provenance import config_record, git_commit
 from nbv.bov.config import BoVRule
 from nbv.bov.refine import DatasetRun, Progress, kept_view_grid, load_views
 from nbv.bov.sweep import PAPER_RANGES, PAPER_WORDS, write_csv
-from nbv.dist.config import ExecutorConfig
-from nbv.dist.executor import run_tasks
-from nbv.dist.task import Task
+from nbv.fanout.config import ExecutorConfig
+from nbv.fanout.executor import run_tasks
+from nbv.fanout.task import Task
 from nbv.experiments.paper_numbers import FULL_SCAN_VIEWS, TABLE2, TABLE2_RANGES, TABLE2_WORDS
 from nbv.experiments.study import FullScanStudy
 from nbv.recon.heatmap import write_heatmap

@@ -17,7 +17,7 @@ from torchrl.envs import EnvBase, ParallelEnv, RewardSum, TransformedEnv
 from torchrl.modules import ProbabilisticActor, ValueOperator
 from torchrl.objectives import SACLoss, SoftUpdate
 
-from nbv.dist.worker import cap_threads
+from nbv.fanout.worker import cap_threads
 from nbv.rl.agent import make_actor, make_critic
 from nbv.rl.config import (
     CollectorConfig,
@@ -100,7 +100,7 @@ def make_collector(env: EnvBase, actor: ProbabilisticActor, config: CollectorCon
 
 def make_worker_env(config: EnvConfig, index: int, seed: int) -> EnvBase:
     """A Ray collector's env, built inside its actor: Dr.Jit and torch capped to the actor's one core
-    (`nbv.dist.worker`), the Mitsuba variant chosen there, returns summed as `make_environment`'s."""
+    (`nbv.fanout.worker`), the Mitsuba variant chosen there, returns summed as `make_environment`'s."""
     cap_threads(RAY_COLLECTOR_CPUS)
     return TransformedEnv(NBVEnv(config, index, seed), RewardSum())
 

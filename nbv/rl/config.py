@@ -20,7 +20,7 @@ from tyro.conf import arg
 
 from common.threads import WORKER_THREADS
 from nbv.bov.config import BoVConfig
-from nbv.dist.config import ExecutorConfig
+from nbv.fanout.config import ExecutorConfig
 from render.camera import UAVCamera
 from render.scan import check_camera_distance
 from render.settings import RenderSettings

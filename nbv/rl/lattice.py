@@ -28,7 +28,7 @@ import torch
 from tqdm import tqdm
 
 from common.io import atomic_path, cache_dir
-from nbv.dist.task import Task
+from nbv.fanout.task import Task
 from nbv.features.sift import FeatureConfig, extract_features
 from nbv.rl.config import EnvConfig, LatticeConfig
 from render.renderer import MitsubaRenderer

@@ -20,9 +20,9 @@ from tqdm import tqdm
 
 from common.io import write_json
 from common.provenance import config_record
-from nbv.dist.config import ExecutorConfig
-from nbv.dist.executor import run_tasks
-from nbv.dist.task import Task
+from nbv.fanout.config import ExecutorConfig
+from nbv.fanout.executor import run_tasks
+from nbv.fanout.task import Task
 from nbv.rl.checkpoint import copy_policy
 from nbv.rl.config import TrainConfig
 from nbv.rl.train import CHECKPOINT, POLICY, VALIDATION_CSV, render_lattices, train

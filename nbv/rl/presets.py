@@ -22,7 +22,7 @@ from dataclasses import replace
 import tyro
 
 from nbv.bov.config import BoVConfig
-from nbv.dist.config import ExecutorConfig
+from nbv.fanout.config import ExecutorConfig
 from nbv.rl.config import (
     CollectorConfig,
     EnvConfig,

@@ -40,7 +40,7 @@ from tqdm import tqdm
 from common.io import write_json
 from common.provenance import config_from_record, config_record
 from common.threads import set_torch_threads
-from nbv.dist.executor import run_tasks
+from nbv.fanout.executor import run_tasks
 from nbv.rl.builders import (
     make_collector,
     make_environment,

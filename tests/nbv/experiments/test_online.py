@@ -67,7 +67,7 @@ def test_online_needs_a_policy_and_a_seed(tmp_path, capsys):
 
 
 def test_online_hands_every_run_of_every_building_to_the_executor_at_once(tmp_path):
-    from nbv.dist.task import unique_tasks
+    from nbv.fanout.task import unique_tasks
     from nbv.experiments.compare import comparison_tasks
     from nbv.experiments.online import comparisons
 

@@ -57,7 +57,7 @@ def test_tables_on_a_tiny_grid(tmp_path):
 def test_tables_on_local_workers_give_the_rows_measured_in_process(tmp_path):
     from dataclasses import replace
 
-    from nbv.dist.config import ExecutorConfig
+    from nbv.fanout.config import ExecutorConfig
 
     config = TablesConfig(out=tmp_path / "here", scenes=("test_building",), ranges=(3,), words=(5,),
                           camera=UAVCamera(64, 48), render=RenderSettings(spp=1),

@@ -124,7 +124,7 @@ def test_planning_env_renders_exact_viewpoints(tmp_path):
 
 
 def test_lattice_units_on_local_workers_cache_what_the_env_renders(tmp_path, monkeypatch):
-    from nbv.dist import ExecutorConfig, run_tasks
+    from nbv.fanout import ExecutorConfig, run_tasks
     from nbv.rl.lattice import lattice_tasks
 
     grid = LatticeConfig(enabled=True, lattice_radii=1, lattice_azimuths=4, lattice_elevations=2)

@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 from dying_units import always_die, die_once, write_result
 
-from nbv.dist import ExecutorConfig, Task, WorkerDied, run_tasks
-from nbv.dist.worker import cap_threads, core_share
+from nbv.fanout import ExecutorConfig, Task, WorkerDied, run_tasks
+from nbv.fanout.worker import cap_threads, core_share
 
 
 def entries(folder) -> list[str]:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import os
 
 from common.threads import set_torch_threads, worker_threads
-from nbv.dist.task import Task, run_task
+from nbv.fanout.task import Task, run_task
 from render.variant import configure_libllvm
 
 

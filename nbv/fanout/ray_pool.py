@@ -2,7 +2,7 @@
 
 Each unit is one Ray task asking for one CPU, so Ray runs as many at once as
 the cluster has cores, and each caps Dr.Jit and torch to that one core
-(`nbv.dist.worker`). Ray retries a unit once when its worker dies
+(`nbv.fanout.worker`). Ray retries a unit once when its worker dies
 (`max_retries=1`; exceptions the unit raises are not retried); a second death
 is reported by name (`WorkerDied`) after its partial files are removed. On a
 cluster the nodes must have this package installed and share the output
@@ -15,8 +15,8 @@ from collections.abc import Callable, Sequence
 from types import ModuleType
 from typing import Any
 
-from nbv.dist.task import Task, WorkerDied, discard_partial
-from nbv.dist.worker import run_in_worker
+from nbv.fanout.task import Task, WorkerDied, discard_partial
+from nbv.fanout.worker import run_in_worker
 
 RETRIES = 1
 """Times a unit is re-run after its worker died."""

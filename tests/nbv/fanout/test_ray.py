@@ -9,7 +9,7 @@ import pytest
 from ray import cloudpickle
 
 from nbv.cli import main
-from nbv.dist import ExecutorConfig, Task, WorkerDied, run_tasks
+from nbv.fanout import ExecutorConfig, Task, WorkerDied, run_tasks
 from scenes import load_scene
 
 RAY = ExecutorConfig(workers=2, ray="auto")

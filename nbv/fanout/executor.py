@@ -12,8 +12,8 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 
-from nbv.dist.config import ExecutorConfig
-from nbv.dist.task import Task, run_task, unique_tasks
+from nbv.fanout.config import ExecutorConfig
+from nbv.fanout.task import Task, run_task, unique_tasks
 
 
 def run_stages(stages: Sequence[Sequence[Task]], executor: ExecutorConfig = ExecutorConfig(),
@@ -32,11 +32,11 @@ def run_stages(stages: Sequence[Sequence[Task]], executor: ExecutorConfig = Exec
     if not todo:
         return []
     if executor.ray is not None:
-        from nbv.dist.ray_pool import run_on_ray
+        from nbv.fanout.ray_pool import run_on_ray
 
         run_on_ray(todo, executor.ray, executor.workers, done)
     elif executor.workers > 1:
-        from nbv.dist.processes import run_in_processes
+        from nbv.fanout.processes import run_in_processes
 
         run_in_processes(todo, executor.workers, done)
     else:

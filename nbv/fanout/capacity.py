@@ -1,6 +1,6 @@
 """Predicted wall time of units of work on a cluster: list scheduling of single-core units (docs/capacity.md).
 
-Every unit runs on one core (`nbv.dist` caps its threads to its share), so a
+Every unit runs on one core (`nbv.fanout` caps its threads to its share), so a
 cluster of N nodes of M cores is N x M slots. A stage's units are handed out
 longest first, each to the slot free soonest (LPT), and stages run one after
 another (a building's full-scan reference before the runs scored against it).

@@ -6,10 +6,10 @@ Names are re-exported lazily (`common.lazy`); Ray itself is imported only when a
 from common.lazy import lazy_exports
 
 _EXPORTS = {
-    "ExecutorConfig": "nbv.dist.config",
-    "Task": "nbv.dist.task",
-    "WorkerDied": "nbv.dist.task",
-    "run_tasks": "nbv.dist.executor",
+    "ExecutorConfig": "nbv.fanout.config",
+    "Task": "nbv.fanout.task",
+    "WorkerDied": "nbv.fanout.task",
+    "run_tasks": "nbv.fanout.executor",
 }
 __all__ = sorted(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -15,8 +15,8 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 
-from nbv.dist.task import Task, WorkerDied, discard_partial
-from nbv.dist.worker import core_share, run_in_worker
+from nbv.fanout.task import Task, WorkerDied, discard_partial
+from nbv.fanout.worker import core_share, run_in_worker
 
 
 def run_in_processes(stages: Sequence[Sequence[Task]], workers: int, on_done: Callable[[Task], None]) -> None:

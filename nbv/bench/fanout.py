@@ -25,11 +25,11 @@ from collections.abc import Callable
 from pathlib import Path
 
 from nbv.bench import BenchResult
+from nbv.experiments.compare import CompareConfig, comparison_tasks
 from nbv.fanout.config import ExecutorConfig
 from nbv.fanout.executor import run_stages
 from nbv.fanout.processes import run_in_processes
 from nbv.fanout.task import Task
-from nbv.experiments.compare import CompareConfig, comparison_tasks
 from nbv.recon.config import MetricsConfig, ReconstructionConfig
 from render.camera import UAVCamera
 from render.settings import RenderSettings

@@ -41,10 +41,10 @@ from common.io import atomic_path, cache_dir, write_json
 from common.provenance import git_commit, run_cache
 from common.threads import apply_thread_policy
 from nbv.bov.config import BoVConfig
+from nbv.experiments.ablation_axes import AXES, REFERENCE, Level, apply_level, check_axes
 from nbv.fanout.config import ExecutorConfig
 from nbv.fanout.executor import run_tasks
 from nbv.fanout.task import Task
-from nbv.experiments.ablation_axes import AXES, REFERENCE, Level, apply_level, check_axes
 from nbv.recon.config import MetricsConfig, ReconstructionConfig
 from render.camera import UAVCamera
 from render.scan import HemispherePlan

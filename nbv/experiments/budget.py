@@ -24,10 +24,10 @@ import numpy as np
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import config_record, git_commit, run_cache
+from nbv.experiments.online import scene_folder
 from nbv.fanout.config import ExecutorConfig
 from nbv.fanout.executor import run_stages
 from nbv.fanout.task import Task
-from nbv.experiments.online import scene_folder
 from nbv.planning.plan import PlanSettings, plan_scan
 from nbv.planning.planners import planner_label
 from nbv.recon.config import MetricsConfig, ReconstructionConfig

@@ -28,10 +28,10 @@ import numpy as np
 
 from common.io import atomic_folder, write_json, write_text
 from common.provenance import config_record, git_commit
+from nbv.experiments.paper_numbers import FIG1_NBV
 from nbv.fanout.config import ExecutorConfig
 from nbv.fanout.executor import run_stages
 from nbv.fanout.task import Task
-from nbv.experiments.paper_numbers import FIG1_NBV
 from nbv.planning.plan import PlanSettings, plan_scan, reference_mesh
 from nbv.planning.planners import planner_label
 from nbv.viz.figures import plot_planner_comparison

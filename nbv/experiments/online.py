@@ -26,10 +26,10 @@ import numpy as np
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import config_record, git_commit
-from nbv.fanout.config import ExecutorConfig
-from nbv.fanout.executor import run_stages
 from nbv.experiments.compare import CompareConfig, compare_planners, comparison_tasks
 from nbv.experiments.paper_numbers import FIG1_NBV, FIG7_GENERALISATION
+from nbv.fanout.config import ExecutorConfig
+from nbv.fanout.executor import run_stages
 from nbv.planning.planners import planner_label
 from nbv.recon.config import MetricsConfig
 from nbv.viz.figures import plot_seed_scores

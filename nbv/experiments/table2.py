@@ -34,11 +34,11 @@ from common.provenance import config_record, git_commit
 from nbv.bov.config import BoVRule
 from nbv.bov.refine import DatasetRun, Progress, kept_view_grid, load_views
 from nbv.bov.sweep import PAPER_RANGES, PAPER_WORDS, write_csv
+from nbv.experiments.paper_numbers import FULL_SCAN_VIEWS, TABLE2, TABLE2_RANGES, TABLE2_WORDS
+from nbv.experiments.study import FullScanStudy
 from nbv.fanout.config import ExecutorConfig
 from nbv.fanout.executor import run_tasks
 from nbv.fanout.task import Task
-from nbv.experiments.paper_numbers import FULL_SCAN_VIEWS, TABLE2, TABLE2_RANGES, TABLE2_WORDS
-from nbv.experiments.study import FullScanStudy
 from nbv.recon.heatmap import write_heatmap
 from nbv.recon.metrics import evaluate_surfaces
 from nbv.recon.tsdf import reconstruct_dataset

@@ -67,9 +67,9 @@ def test_online_needs_a_policy_and_a_seed(tmp_path, capsys):
 
 
 def test_online_hands_every_run_of_every_building_to_the_executor_at_once(tmp_path):
-    from nbv.fanout.task import unique_tasks
     from nbv.experiments.compare import comparison_tasks
     from nbv.experiments.online import comparisons
+    from nbv.fanout.task import unique_tasks
 
     config = OnlineConfig(out=tmp_path, scenes=("alpine_chalet", "random:5"), seeds=(0, 1))
     stages = [comparison_tasks(comparison) for comparison in comparisons(config)]

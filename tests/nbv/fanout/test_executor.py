@@ -57,7 +57,8 @@ def test_a_worker_killed_mid_unit_is_retried_and_one_that_always_dies_is_named(t
     workers = ExecutorConfig(workers=2)
     dies = Task("dies once", die_once, {"out": tmp_path / "once", "marker": tmp_path / "marker"},
                 tmp_path / "once" / "result.txt")
-    fine = Task("fine", write_result, {"out": tmp_path / "fine", "text": "fine"}, tmp_path / "fine" / "result.txt")
+    fine = Task("fine", write_result, {"out": tmp_path / "fine", "text": "fine"},
+                tmp_path / "fine" / "result.txt")
     assert run_tasks([dies, fine], workers) == [dies, fine]
     assert (tmp_path / "once" / "result.txt").read_text() == "second try"
     assert (tmp_path / "fine" / "result.txt").read_text() == "fine"

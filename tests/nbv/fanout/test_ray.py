@@ -29,7 +29,8 @@ def test_a_comparison_on_ray_gives_the_numbers_of_one_in_process(tmp_path, capsy
     for mine, theirs in zip(here["runs"], ray["runs"], strict=True):
         assert {k: mine[k] for k in ("planner", "seed", "views", "gt", "reference")} == \
             {k: theirs[k] for k in ("planner", "seed", "views", "gt", "reference")}
-    assert (tmp_path / "here" / "comparison.md").read_text() == (tmp_path / "ray" / "comparison.md").read_text()
+    here, there = (tmp_path / out / "comparison.md" for out in ("here", "ray"))
+    assert here.read_text() == there.read_text()
     for run in ("random-seed1", "circle-seed0"):
         plans = [json.loads((tmp_path / out / run / "plan.json").read_text()) for out in ("here", "ray")]
         assert plans[0]["viewpoints"] == plans[1]["viewpoints"] and plans[0]["gt"] == plans[1]["gt"]
@@ -38,7 +39,8 @@ def test_a_comparison_on_ray_gives_the_numbers_of_one_in_process(tmp_path, capsy
 def test_a_ray_worker_killed_mid_unit_is_retried_and_one_that_always_dies_is_named(tmp_path):
     cloudpickle.register_pickle_by_value(dying_units)  # Ray workers do not have tests/ on their path
     try:
-        dies = Task("dies once", dying_units.die_once, {"out": tmp_path / "once", "marker": tmp_path / "marker"},
+        dies = Task("dies once", dying_units.die_once,
+                    {"out": tmp_path / "once", "marker": tmp_path / "marker"},
                     tmp_path / "once" / "result.txt")
         assert run_tasks([dies], RAY) == [dies]
         assert (tmp_path / "once" / "result.txt").read_text() == "second try"

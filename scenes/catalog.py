@@ -6,12 +6,12 @@ imported when a scene is loaded, so `nbv scene list` starts at once.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import os
+from collections import OrderedDict
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from common.io import atomic_folder, check_output_folder
-from scenes.spec import SceneSpec
+from common.io import cache_dir
 
 if TYPE_CHECKING:
     from scenes.model import Scene
@@ -26,6 +26,9 @@ DEFAULT_SCENE = "medieval_tavern"
 """The scene `make demo` uses."""
 RANDOM_PREFIX = "random:"
 """`random:SEED` names a building drawn from the grammar (see `scenes.presets`)."""
+MEMO_SIZE = 8
+"""Scenes a process keeps loaded (`load_scene`), the least recently used dropped first."""
+_MEMO: OrderedDict[tuple, Scene] = OrderedDict()
 
 
 def list_scenes() -> list[str]:
@@ -36,6 +39,9 @@ def list_scenes() -> list[str]:
 def load_scene(spec: str, up_axis: str = "z") -> Scene:
     """A scene by built-in name, `random:SEED`, or mesh / Mitsuba XML file path.
 
+    A process builds each scene once (a procedural building takes seconds): the scene is kept, its
+    arrays made read-only, and given again while its texture files and its mesh file are unchanged.
+
     Args:
         spec: what to load.
         up_axis: 'z' or 'y', the up axis of a mesh file (built-in scenes are z up).
@@ -44,6 +50,36 @@ def load_scene(spec: str, up_axis: str = "z") -> Scene:
         ValueError: unknown name, bad seed, unreadable or invalid mesh.
         FileNotFoundError: a mesh or XML path that does not exist.
     """
+    key = _memo_key(spec, up_axis)
+    scene = _MEMO.get(key)
+    if scene is None or not all(part.material.texture is None or part.material.texture.exists()
+                                for part in scene.parts):
+        scene = _frozen(_build(spec, up_axis))
+    _MEMO[key] = scene
+    _MEMO.move_to_end(key)
+    while len(_MEMO) > MEMO_SIZE:
+        _MEMO.popitem(last=False)
+    return scene
+
+
+def _memo_key(spec: str, up_axis: str) -> tuple:
+    """What a loaded scene depends on: the textures' cache folder, and a mesh file's state and up axis."""
+    if spec in BUILTIN_NAMES or spec.startswith(RANDOM_PREFIX) or not os.path.exists(spec):
+        return spec, str(cache_dir())
+    state = os.stat(spec)
+    return str(Path(spec).resolve()), up_axis, state.st_mtime_ns, state.st_size, str(cache_dir())
+
+
+def _frozen(scene: Scene) -> Scene:
+    """`scene` with its arrays read-only, so no user of a shared scene can change it for the next."""
+    for part in scene.parts:
+        for array in (part.vertices, part.faces, part.uv):
+            if array is not None:
+                array.flags.writeable = False
+    return scene
+
+
+def _build(spec: str, up_axis: str) -> Scene:
     if spec in PRESET_NAMES:
         from scenes.presets import build_preset
 
@@ -67,24 +103,3 @@ def load_scene(spec: str, up_axis: str = "z") -> Scene:
         f"unknown scene {spec!r}; built-in scenes: {', '.join(list_scenes())}; "
         f"or random:SEED, or a mesh / Mitsuba XML file path"
     )
-
-
-@dataclass(frozen=True, kw_only=True)
-class ExportConfig(SceneSpec):
-    """Settings of `nbv scene export`: a target and the folder for its mesh."""
-
-    out: Path
-    """Output folder for mesh.ply."""
-    overwrite: bool = False
-    """Replace an existing OUT/mesh.ply."""
-
-
-def export_scene(config: ExportConfig) -> Path:
-    """Write the normalised target mesh (exactly as rendered, no ground) to `out/mesh.ply`, atomically
-    (other files in `out` are kept)."""
-    out = Path(config.out)
-    check_output_folder(out, config.overwrite, ("mesh.ply",))
-    mesh = config.load().target_mesh()
-    with atomic_folder(out, config.overwrite, ("mesh.ply",)) as folder:
-        mesh.export(folder / "mesh.ply", file_type="ply")
-    return out / "mesh.ply"

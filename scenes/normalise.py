@@ -11,8 +11,8 @@ from dataclasses import replace
 
 import numpy as np
 
+from scenes.axes import UP_AXES
 from scenes.model import Part
-from scenes.spec import UP_AXES
 from scenes.surface import Finish, make_part
 from scenes.textures import TEXTURES
 

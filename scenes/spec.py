@@ -8,17 +8,14 @@ declared once here and reaches every command that takes a scene.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Annotated, Literal, get_args
+from typing import TYPE_CHECKING, Annotated
 
 from tyro.conf import Positional, UseAppendAction, arg
 
+from scenes.axes import UpAxis
+
 if TYPE_CHECKING:
     from scenes.model import Scene
-
-UpAxis = Literal["z", "y"]
-"""The up axis of a mesh file; 'y' (glTF, many DCC exports) is turned to z up."""
-UP_AXES: tuple[str, ...] = get_args(UpAxis)
-"""Up axes a mesh file may use."""
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -38,7 +38,7 @@ def main(args: Sequence[str], prog: str) -> int:
         return 0
     if action == "export":
         from nbv.cli.parse import parse
-        from scenes.catalog import ExportConfig, export_scene
+        from scenes.export import ExportConfig, export_scene
 
         print(export_scene(parse(ExportConfig, rest, f"{prog} export")))
         return 0

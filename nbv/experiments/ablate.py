@@ -41,7 +41,7 @@ from common.io import atomic_path, cache_dir, write_json
 from common.provenance import git_commit, run_cache
 from common.threads import apply_thread_policy
 from nbv.bov.config import BoVConfig
-from nbv.experiments.ablation_axes import AXES, REFERENCE, Level, apply_level, check_axes
+from nbv.experiments.ablation_axes import AXES, Unit, apply_level, check_axes, unit_path, units
 from nbv.fanout.config import ExecutorConfig
 from nbv.fanout.executor import run_tasks
 from nbv.fanout.task import Task
@@ -136,41 +136,6 @@ QUICK = AblateConfig(quick=True, seeds=(0,), camera=UAVCamera(96, 72),
                      quality_views=2, greedy_views=4, greedy_candidates=3,
                      metrics=MetricsConfig(n_points=10_000))
 """`nbv ablate --quick`: every axis on the test building, one seed, 96x72, a 20-view scan, 4 greedy views."""
-
-
-@dataclass(frozen=True)
-class Unit:
-    """One measurement: a level of an axis (or the reference) on one building with one seed."""
-
-    scene: str
-    axis: str
-    level: Level
-    seed: int
-
-    @property
-    def name(self) -> str:
-        """A readable name, e.g. `medieval_tavern / spp=4 / seed 0`."""
-        return f"{self.scene} / {self.axis}={self.level.label} / seed {self.seed}"
-
-
-def _slug(text: str) -> str:
-    return "".join(c if c.isalnum() or c in "-." else "_" for c in text)
-
-
-def units(config: AblateConfig) -> list[Unit]:
-    """Every unit of the run: per building and seed, the reference, then each axis's other levels."""
-    out = []
-    for scene in config.scenes:
-        for seed in config.seeds:
-            out.append(Unit(scene, REFERENCE, Level(REFERENCE), seed))
-            out += [Unit(scene, name, level, seed) for name in config.axes
-                    for level in AXES[name].levels if not level.is_reference]
-    return out
-
-
-def unit_path(folder: Path, unit: Unit) -> Path:
-    """Where `unit`'s result JSON lives under `folder`."""
-    return folder / _slug(unit.scene) / _slug(unit.axis) / f"{_slug(unit.level.label)}-seed{unit.seed}.json"
 
 
 def quality_indices(views: int, count: int) -> list[int]:

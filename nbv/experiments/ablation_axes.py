@@ -6,14 +6,21 @@ with no override is the reference (today's defaults), shared by every axis, so
 it is measured once per building and seed. Axes marked `lighting` are also
 scored by greedy Bag of Views planning (the paper warns that SIFT makes the
 Bag of Views sensitive to lighting).
+
+A run's units (`units`) are the reference and every other level, per building
+and seed; each keeps its result where `unit_path` says.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Any
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from render.settings import RenderSettings
+
+if TYPE_CHECKING:
+    from nbv.experiments.ablate import AblateConfig
 
 REFERENCE = "reference"
 """Axis and level name of the reference setting's own measurement."""
@@ -103,3 +110,37 @@ def check_axes(names: tuple[str, ...]) -> None:
     if unknown:
         raise ValueError(f"unknown axis {unknown[0]!r} (choose from {', '.join(AXES)})")
 
+
+@dataclass(frozen=True)
+class Unit:
+    """One measurement: a level of an axis (or the reference) on one building with one seed."""
+
+    scene: str
+    axis: str
+    level: Level
+    seed: int
+
+    @property
+    def name(self) -> str:
+        """A readable name, e.g. `medieval_tavern / spp=4 / seed 0`."""
+        return f"{self.scene} / {self.axis}={self.level.label} / seed {self.seed}"
+
+
+def _slug(text: str) -> str:
+    return "".join(c if c.isalnum() or c in "-." else "_" for c in text)
+
+
+def units(config: AblateConfig) -> list[Unit]:
+    """Every unit of the run: per building and seed, the reference, then each axis's other levels."""
+    out = []
+    for scene in config.scenes:
+        for seed in config.seeds:
+            out.append(Unit(scene, REFERENCE, Level(REFERENCE), seed))
+            out += [Unit(scene, name, level, seed) for name in config.axes
+                    for level in AXES[name].levels if not level.is_reference]
+    return out
+
+
+def unit_path(folder: Path, unit: Unit) -> Path:
+    """Where `unit`'s result JSON lives under `folder`."""
+    return folder / _slug(unit.scene) / _slug(unit.axis) / f"{_slug(unit.level.label)}-seed{unit.seed}.json"

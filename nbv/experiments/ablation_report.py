@@ -11,7 +11,7 @@ level), `crops.png` (the same crop of one view at every level) and
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from PIL import Image
@@ -19,8 +19,11 @@ from PIL import Image
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import config_record, git_commit
 from nbv.bov.sweep import write_csv
-from nbv.experiments.ablation_axes import AXES, REFERENCE, Level
+from nbv.experiments.ablation_axes import AXES, REFERENCE, Level, Unit, unit_path
 from nbv.viz.ablation import plot_axis, plot_crops, plot_quality_vs_time
+
+if TYPE_CHECKING:
+    from nbv.experiments.ablate import AblateConfig
 
 METRICS = (("render_s_per_view", "render s/view", 1.0, ".3f"),
            ("psnr_db", "PSNR dB", 1.0, ".2f"),
@@ -104,7 +107,7 @@ def findings(rows: list[dict[str, Any]]) -> list[str]:
     return lines
 
 
-def rerun_command(config: Any) -> str:
+def rerun_command(config: AblateConfig) -> str:
     """The `nbv ablate` command line that re-runs `config`'s axes, buildings and seeds."""
     if config.quick:
         return "nbv ablate --quick --out DIR"
@@ -113,7 +116,7 @@ def rerun_command(config: Any) -> str:
             + f" --out {config.out}")
 
 
-def readme(config: Any, rows: list[dict[str, Any]], header: dict[str, Any]) -> str:
+def readme(config: AblateConfig, rows: list[dict[str, Any]], header: dict[str, Any]) -> str:
     """README.md of the ablation folder: how it was measured, the table, the findings."""
     ref = config.render
     return "\n".join([
@@ -136,10 +139,9 @@ def readme(config: Any, rows: list[dict[str, Any]], header: dict[str, Any]) -> s
         "Plots: `axis_<name>.png` (each metric against the level), `quality_vs_time.png`, `crops.png`.", ""])
 
 
-def _crop_images(docs: list[dict[str, Any]], folder: Path, config: Any) -> dict[str, list[tuple[str, Any]]]:
+def _crop_images(docs: list[dict[str, Any]], folder: Path,
+                 config: AblateConfig) -> dict[str, list[tuple[str, Any]]]:
     """Per axis, (level, image) of the first building and seed's first quality view, where it was saved."""
-    from nbv.experiments.ablate import Unit, unit_path
-
     scene, seed = config.scenes[0], config.seeds[0]
     grid = {}
     for name in config.axes:
@@ -155,7 +157,7 @@ def _crop_images(docs: list[dict[str, Any]], folder: Path, config: Any) -> dict[
     return grid
 
 
-def write_report(config: Any, docs: list[dict[str, Any]], folder: Path, seconds: float) -> None:
+def write_report(config: AblateConfig, docs: list[dict[str, Any]], folder: Path, seconds: float) -> None:
     """Write every output of the run onto `config.out` together."""
     rows = summary_rows(docs, config.axes)
     header = {"command": rerun_command(config).replace("DIR", str(config.out)), "commit": git_commit(),

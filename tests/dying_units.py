@@ -35,3 +35,8 @@ def _die_writing(out: Path) -> None:
     with atomic_folder(out, overwrite=True) as tmp:
         (tmp / "result.txt").write_text("half")
         os.kill(os.getpid(), signal.SIGKILL)
+
+
+def write_pid_and_env(out: Path, name: str) -> None:
+    """Write `out/result.txt`: this process's id and the value of environment variable `name`."""
+    write_result(out, f"{os.getpid()} {os.environ.get(name, '-')}")

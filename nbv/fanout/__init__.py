@@ -9,7 +9,9 @@ _EXPORTS = {
     "ExecutorConfig": "nbv.fanout.config",
     "Task": "nbv.fanout.task",
     "WorkerDied": "nbv.fanout.task",
+    "run_stages": "nbv.fanout.executor",
     "run_tasks": "nbv.fanout.executor",
+    "start_workers": "nbv.fanout.executor",
 }
 __all__ = sorted(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

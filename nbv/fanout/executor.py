@@ -4,8 +4,10 @@ The executor only decides where units run: each writes its own files, so the
 files (and every number read back from them) are the same whichever runs them.
 Units already done are skipped; repeats (same name and settings) run once.
 Stages run in order, each once the one before is finished (e.g. a scene's
-cached reference, then the runs scored against it), on one pool of workers or
-one Ray connection.
+cached reference, then the runs scored against it). The workers (a local pool
+or a Ray connection) live for the whole process: every stage and every call
+runs on the same warm ones, and `start_workers` starts them before the first
+units come, while the caller sets up.
 """
 
 from __future__ import annotations
@@ -14,6 +16,18 @@ from collections.abc import Callable, Sequence
 
 from nbv.fanout.config import ExecutorConfig
 from nbv.fanout.task import Task, run_task, unique_tasks
+
+
+def start_workers(executor: ExecutorConfig) -> None:
+    """Start `executor`'s workers now, warming up in the background (nothing to start in process)."""
+    if executor.ray is not None:
+        from nbv.fanout.ray_pool import connect
+
+        connect(executor.ray, executor.workers)
+    elif executor.workers > 1:
+        from nbv.fanout.processes import start_pool
+
+        start_pool(executor.workers)
 
 
 def run_stages(stages: Sequence[Sequence[Task]], executor: ExecutorConfig = ExecutorConfig(),

@@ -1,11 +1,15 @@
-"""`run_tasks` in process and on local workers: skips, repeats, named errors, a worker killed mid-unit."""
+"""`run_tasks` in process and on local workers: skips, repeats, named errors, a worker killed mid-unit, warm
+workers kept for the process."""
 
 from __future__ import annotations
 
-import pytest
-from dying_units import always_die, die_once, write_result
+import os
 
-from nbv.fanout import ExecutorConfig, Task, WorkerDied, run_tasks
+import pytest
+from dying_units import always_die, die_once, write_pid_and_env, write_result
+
+from nbv.fanout import ExecutorConfig, Task, WorkerDied, run_tasks, start_workers
+from nbv.fanout.processes import start_pool
 from nbv.fanout.worker import cap_threads, core_share
 
 
@@ -67,3 +71,25 @@ def test_a_worker_killed_mid_unit_is_retried_and_one_that_always_dies_is_named(t
     with pytest.raises(WorkerDied, match="task 'doomed': its worker process died twice"):
         run_tasks([doomed], workers)
     assert entries(tmp_path) == ["fine", "marker", "once"]
+
+
+def test_workers_live_for_the_process_and_take_the_callers_nbv_environment(tmp_path, monkeypatch):
+    workers = ExecutorConfig(workers=2)
+    start_workers(workers)
+
+    def unit(name: str) -> Task:
+        return Task(name, write_pid_and_env, {"out": tmp_path / name, "name": "NBV_PROBE"},
+                    tmp_path / name / "result.txt")
+
+    def seen(name: str) -> tuple[int, str]:
+        pid, value = (tmp_path / name / "result.txt").read_text().split()
+        return int(pid), value
+
+    monkeypatch.setenv("NBV_PROBE", "first")
+    run_tasks([unit("a"), unit("b")], workers)
+    monkeypatch.setenv("NBV_PROBE", "second")  # set after the workers started
+    run_tasks([unit("c"), unit("d")], workers)
+    first, later = {seen("a"), seen("b")}, {seen("c"), seen("d")}
+    assert {value for _, value in first} == {"first"} and {value for _, value in later} == {"second"}
+    pids = {pid for pid, _ in first | later}
+    assert os.getpid() not in pids and pids <= {p.pid for p in start_pool(2)._processes.values()}

@@ -28,7 +28,8 @@ def config_record(config: Any, omit: tuple[str, ...] = ()) -> dict:
 def config_from_record(cls: type[T], record: dict) -> T:
     """The config dataclass `cls` rebuilt from `config_record`'s output (the inverse, nested included).
 
-    Keys the record lacks take the field's default; unknown keys are an error naming them.
+    Keys the record lacks take the field's default; unknown keys are an error naming them. A class with
+    an `upgrade_record(record) -> record` static method first brings an older layout up to date.
 
     Example:
         >>> Run = dataclasses.make_dataclass("Run", [("sizes", tuple[int, ...]), ("out", Path | None)])
@@ -37,6 +38,9 @@ def config_from_record(cls: type[T], record: dict) -> T:
     """
     if not isinstance(record, dict):
         raise ValueError(f"a {cls.__name__} record must be a JSON object, got {type(record).__name__}")
+    upgrade = getattr(cls, "upgrade_record", None)
+    if upgrade is not None:
+        record = upgrade(record)
     hints = typing.get_type_hints(cls, include_extras=False)
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
     unknown = sorted(set(record) - set(fields))

@@ -19,13 +19,12 @@ from scenes.model import Scene
 
 
 def capture_dataset(scene: Scene, camera: UAVCamera, viewpoints: Sequence[Viewpoint], out: str | Path,
-                    settings: RenderSettings = RenderSettings(), variant: str | None = None,
-                    meta: dict[str, Any] | None = None, overwrite: bool = False,
-                    progress: bool = True) -> Path:
+                    settings: RenderSettings = RenderSettings(), meta: dict[str, Any] | None = None,
+                    overwrite: bool = False, progress: bool = True) -> Path:
     """Render `viewpoints` of `scene` and write them atomically as a dataset at `out`.
 
     View i is rendered with seed `settings.view_seed(i)`, so a dataset is
-    reproducible bit for bit on the same machine and variant. Images have the
+    reproducible bit for bit on the same machine and variant (`settings.variant`). Images have the
     camera's size times `settings.resolution_scale` (field of view kept), and the
     dataset records that camera. An interruption leaves nothing at `out` (or the
     previous content, with `overwrite`).
@@ -33,7 +32,7 @@ def capture_dataset(scene: Scene, camera: UAVCamera, viewpoints: Sequence[Viewpo
     if not viewpoints:
         raise ValueError("a scan needs at least one viewpoint")
     check_output_folder(Path(out), overwrite)
-    renderer = MitsubaRenderer(scene, camera, settings, variant)
+    renderer = MitsubaRenderer(scene, camera, settings)
     doc = {"scene": scene.name, "center": renderer.center.tolist(), "variant": renderer.variant,
            "render": asdict(settings), "seed": settings.seed, **(meta or {})}
     with DatasetWriter(out, renderer.camera, doc, overwrite) as writer:
@@ -53,5 +52,4 @@ def scan_dataset(config: ScanConfig) -> Path:
                      "elevation_deg": config.elevation},
             "up_axis": config.scene.up_axis}
     return capture_dataset(config.scene.load(), config.camera, views, config.out,
-                           replace(config.render, seed=config.seed), config.render.variant, meta,
-                           config.overwrite)
+                           replace(config.render, seed=config.seed), meta, config.overwrite)

@@ -12,7 +12,7 @@ from tqdm import tqdm
 from render.camera import UAVCamera
 from render.dataset import DatasetWriter, check_output_folder
 from render.renderer import MitsubaRenderer
-from render.scan import ScanConfig
+from render.scan import ScanConfig, plan_record
 from render.settings import RenderSettings
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes.model import Scene
@@ -47,9 +47,6 @@ def capture_dataset(scene: Scene, camera: UAVCamera, viewpoints: Sequence[Viewpo
 def scan_dataset(config: ScanConfig) -> Path:
     """Render the scan `config` describes (`nbv scan`) and return the dataset folder."""
     views = config.viewpoints()
-    meta = {"plan": {"name": config.plan, "radius": config.radius, "end_overlap": config.end_overlap,
-                     "side_overlap": config.side_overlap, "views": len(views),
-                     "elevation_deg": config.elevation},
-            "up_axis": config.scene.up_axis}
+    meta = {"plan": plan_record(config.plan, len(views)), "up_axis": config.scene.up_axis}
     return capture_dataset(config.scene.load(), config.camera, views, config.out,
                            replace(config.render, seed=config.seed), meta, config.overwrite)

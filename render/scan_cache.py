@@ -20,7 +20,7 @@ from common.io import cache_dir
 from render.camera import UAVCamera
 from render.capture import capture_dataset
 from render.dataset import DatasetError, ViewDataset, read_dataset
-from render.scan import HemispherePlan, hemisphere_scan
+from render.scan import HemispherePlan, hemisphere_scan, plan_record
 from render.settings import RenderSettings
 from render.variant import select_variant
 from render.viewpoint import Viewpoint
@@ -72,7 +72,7 @@ def full_scan(scene: Scene, camera: UAVCamera, folder: str | Path | None = None,
     if folder is None:
         safe = "".join(c if c.isalnum() or c in "_-" else "_" for c in scene.name)[:40]
         folder = cache_dir() / "scans" / f"{safe}-{scene_digest(scene)}-{camera.width}x{camera.height}"
-    meta = {"plan": {"name": "hemisphere", **asdict(plan), "views": len(viewpoints)}}
+    meta = {"plan": plan_record(plan, len(viewpoints))}
     return ensure_scan(scene, camera, viewpoints, folder, settings, meta, fresh, progress)
 
 

@@ -19,8 +19,9 @@ from tyro._errors import InstantiationFailure, ParseErrorEvent, on_parse_error  
 
 T = TypeVar("T")
 
-MARKERS = (tyro.conf.OmitArgPrefixes,)
-"""How every command's config becomes options: flat names, nested groups in `--help`."""
+MARKERS = (tyro.conf.OmitArgPrefixes, tyro.conf.CascadeSubcommandArgs)
+"""How every command's config becomes options: flat names, nested groups in `--help`, and a command's
+own options accepted after a subcommand (`nbv scan SCENE circle --views 8 --out DIR`)."""
 
 
 def _refused_value(event: ParseErrorEvent) -> None:

@@ -20,7 +20,8 @@ def test_help_builds_and_exits_0(name, capsys):
 
 
 @pytest.mark.parametrize("name, flags", [
-    ("scan", ["--width", "--spp", "--up-axis", "--seed", "--variant", "--denoiser", "--pixel-filter",
+    ("scan", ["hemisphere", "circle", "--width", "--spp", "--up-axis", "--seed", "--variant", "--denoiser",
+              "--pixel-filter",
               "--resolution-scale", "--texture-scale", "--motion-blur-m", "--motion-blur-frames",
               "--sky-model", "--light-mode", "--sun-elevation-deg", "--sun-azimuth-deg", "--turbidity",
               "--exposure-stops", "--shot-noise", "--read-noise", "--jpeg-quality"]),

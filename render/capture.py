@@ -9,6 +9,7 @@ from typing import Any
 
 from tqdm import tqdm
 
+from common.provenance import run_record
 from render.camera import UAVCamera
 from render.dataset import DatasetWriter, check_output_folder
 from render.renderer import MitsubaRenderer
@@ -47,6 +48,7 @@ def capture_dataset(scene: Scene, camera: UAVCamera, viewpoints: Sequence[Viewpo
 def scan_dataset(config: ScanConfig) -> Path:
     """Render the scan `config` describes (`nbv scan`) and return the dataset folder."""
     views = config.viewpoints()
-    meta = {"plan": plan_record(config.plan, len(views)), "up_axis": config.scene.up_axis}
+    meta = {"plan": plan_record(config.plan, len(views)), "up_axis": config.scene.up_axis,
+            **run_record("nbv scan", config)}
     return capture_dataset(config.scene.load(), config.camera, views, config.out,
                            replace(config.render, seed=config.seed), meta, config.overwrite)

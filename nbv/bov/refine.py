@@ -22,7 +22,7 @@ import torch
 from tyro.conf import Positional, arg
 
 from common.io import check_separate
-from common.provenance import config_record
+from common.provenance import config_record, run_record
 from common.threads import set_torch_threads
 from nbv.bov.bag import BagOfViews
 from nbv.bov.config import BoVConfig, BoVRule
@@ -168,7 +168,8 @@ def refine_dataset(config: RefineConfig, progress: Progress | None = None) -> di
                "kept": result.kept, "scores": [_json_score(s) for s in result.scores],
                "ranges": result.ranges, "settings": settings,
                "seconds": round(time.perf_counter() - start, 3),
-               "note": "scores: null is +inf (first view of an empty range); a view is kept iff score > 0"}
+               "note": "scores: null is +inf (first view of an empty range); a view is kept iff score > 0",
+               **run_record("nbv refine", config)}
     write_subset(dataset, result.kept, out, {"refine": {"source": str(config.dataset), **settings}},
                  config.overwrite, extra={"refine.json": summary})
     return summary

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from common.io import atomic_folder, check_output_folder, write_json
-from common.provenance import config_record
+from common.provenance import config_record, run_record
 from common.threads import chosen_threads, limit_torch_threads, worker_threads
 from nbv.bov.config import BoVConfig
 from nbv.planning.planners import Planner, PolicyPlanner, make_planner
@@ -209,7 +209,7 @@ def plan_scan(config: PlanConfig) -> dict:
         doc = {"planner": config.planner, "scene": config.scene.scene, "views": len(views),
                "planning_s": plan_s, "deciding_s": plan_s - camera_s,
                "viewpoints": [v.as_array().tolist() for v in views],
-               "config": config_record(config),
+               **run_record("nbv plan", config),
                **{name: result.as_dict() for name, result in results.items()}}
         write_json(folder / "plan.json", doc)
         poses = np.stack([viewpoint_to_c2w(v, scene.center()) for v in views])

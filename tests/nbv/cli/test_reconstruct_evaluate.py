@@ -44,7 +44,7 @@ def test_reconstruct_then_evaluate(dataset, tmp_path, capsys) -> None:
     assert len(mesh.faces) > 1000
     assert len(trimesh.load(recon / "points.ply").vertices) > 1000
     summary = json.loads((recon / "reconstruction.json").read_text())
-    assert summary["views"] == 37 and summary["config"]["voxel_size_m"] == 0.004
+    assert summary["views"] == 37 and summary["config"]["recon"]["voxel_size_m"] == 0.004
 
     ev = tmp_path / "eval"
     assert main(["evaluate", str(recon / "mesh.ply"), "--gt", "test_building", "--reference",
@@ -64,7 +64,7 @@ def test_reconstruct_then_evaluate(dataset, tmp_path, capsys) -> None:
     assert main(["evaluate", str(recon / "mesh.ply"), "--gt", str(gt_file), "--out", str(tmp_path / "ev2"),
                  "--metric-points", "50000", "--threshold-cm", "0.5"]) == 0
     doc2 = json.loads((tmp_path / "ev2" / "metrics.json").read_text())
-    assert set(doc2) == {"gt", "run"} and doc2["gt"]["threshold_cm"] == 0.5
+    assert set(doc2) == {"gt", "run", "commit", "command", "config"} and doc2["gt"]["threshold_cm"] == 0.5
     assert doc2["gt"]["chamfer_cm"] == pytest.approx(doc["gt"]["chamfer_cm"], rel=1e-6)
 
     # Nothing written is lost: a second run into the same folders refuses without --overwrite.

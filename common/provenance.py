@@ -1,4 +1,9 @@
-"""Where a result came from: the commit that produced it, and its config as a record and back."""
+"""Where a result came from: the commit that produced it, and its config as a record and back.
+
+Every single-run output (`plan.json`, `metrics.json`, `refine.json`, `reconstruction.json`,
+`sweep.json`, a scan's `transforms.json` under `nbv`) carries one `run_record`: `commit`, `command`
+and the whole `config`, and `nbv COMMAND --config FILE` re-runs it (`recorded_config`).
+"""
 
 from __future__ import annotations
 
@@ -28,7 +33,8 @@ def config_record(config: Any, omit: tuple[str, ...] = ()) -> dict:
 def config_from_record(cls: type[T], record: dict) -> T:
     """The config dataclass `cls` rebuilt from `config_record`'s output (the inverse, nested included).
 
-    Keys the record lacks take the field's default; unknown keys are an error naming them.
+    Keys the record lacks take the field's default; unknown keys are an error naming them. A class with
+    an `upgrade_record(record) -> record` static method first brings an older layout up to date.
 
     Example:
         >>> Run = dataclasses.make_dataclass("Run", [("sizes", tuple[int, ...]), ("out", Path | None)])
@@ -37,6 +43,9 @@ def config_from_record(cls: type[T], record: dict) -> T:
     """
     if not isinstance(record, dict):
         raise ValueError(f"a {cls.__name__} record must be a JSON object, got {type(record).__name__}")
+    upgrade = getattr(cls, "upgrade_record", None)
+    if upgrade is not None:
+        record = upgrade(record)
     hints = typing.get_type_hints(cls, include_extras=False)
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
     unknown = sorted(set(record) - set(fields))
@@ -50,7 +59,7 @@ def _value(tp: Any, value: Any) -> Any:
         return None
     if typing.get_origin(tp) in (typing.Union, types.UnionType):
         options = [a for a in typing.get_args(tp) if a is not type(None)]
-        tp = options[0] if len(options) == 1 else Any
+        tp = options[0] if len(options) == 1 else _recorded_option(options, value)
     if dataclasses.is_dataclass(tp):
         return config_from_record(tp, value)
     if typing.get_origin(tp) is tuple and isinstance(value, list):
@@ -60,6 +69,39 @@ def _value(tp: Any, value: Any) -> Any:
     if tp is Path:
         return Path(value)
     return value
+
+
+def _recorded_option(options: list[Any], value: Any) -> Any:
+    """The dataclass of a union (e.g. a scan plan) whose fields are exactly the record's keys, else Any."""
+    if isinstance(value, dict):
+        for option in filter(dataclasses.is_dataclass, options):
+            if {f.name for f in dataclasses.fields(option)} == value.keys():
+                return option
+    return Any
+
+
+def run_record(command: str, config: Any) -> dict[str, Any]:
+    """The provenance of one run, in the one style of every single-run output: the `commit`, the
+    `command` that ran (e.g. "nbv plan") and its whole `config` (`config_record`)."""
+    return {"commit": git_commit(), "command": command, "config": config_record(config)}
+
+
+def recorded_config(cls: type[T], path: str | Path, command: str) -> T:
+    """The config `cls` of the run record in the JSON file `path` (its `config`, or a dataset's
+    `nbv.config`), refused (ValueError naming the file) when another command wrote it."""
+    try:
+        doc = json.loads(Path(path).read_text())
+    except (OSError, ValueError) as err:
+        raise ValueError(f"--config {path}: not a readable JSON file ({err})") from err
+    record = doc.get("nbv", {}) if isinstance(doc, dict) and "config" not in doc else doc
+    if not isinstance(record, dict) or not isinstance(record.get("config"), dict):
+        raise ValueError(f"--config {path}: no run record (a `config` object) in it")
+    if record.get("command", command) != command:
+        raise ValueError(f"--config {path}: recorded by `{record['command']}`, not `{command}`")
+    try:
+        return config_from_record(cls, record["config"])
+    except TypeError as err:
+        raise ValueError(f"--config {path}: {err}") from err
 
 
 RESULTS = "paper_results"

@@ -9,23 +9,23 @@ from typing import Any
 
 from tqdm import tqdm
 
+from common.provenance import run_record
 from render.camera import UAVCamera
 from render.dataset import DatasetWriter, check_output_folder
 from render.renderer import MitsubaRenderer
-from render.scan import ScanConfig
+from render.scan import ScanConfig, plan_record
 from render.settings import RenderSettings
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes.model import Scene
 
 
 def capture_dataset(scene: Scene, camera: UAVCamera, viewpoints: Sequence[Viewpoint], out: str | Path,
-                    settings: RenderSettings = RenderSettings(), variant: str | None = None,
-                    meta: dict[str, Any] | None = None, overwrite: bool = False,
-                    progress: bool = True) -> Path:
+                    settings: RenderSettings = RenderSettings(), meta: dict[str, Any] | None = None,
+                    overwrite: bool = False, progress: bool = True) -> Path:
     """Render `viewpoints` of `scene` and write them atomically as a dataset at `out`.
 
     View i is rendered with seed `settings.view_seed(i)`, so a dataset is
-    reproducible bit for bit on the same machine and variant. Images have the
+    reproducible bit for bit on the same machine and variant (`settings.variant`). Images have the
     camera's size times `settings.resolution_scale` (field of view kept), and the
     dataset records that camera. An interruption leaves nothing at `out` (or the
     previous content, with `overwrite`).
@@ -33,7 +33,7 @@ def capture_dataset(scene: Scene, camera: UAVCamera, viewpoints: Sequence[Viewpo
     if not viewpoints:
         raise ValueError("a scan needs at least one viewpoint")
     check_output_folder(Path(out), overwrite)
-    renderer = MitsubaRenderer(scene, camera, settings, variant)
+    renderer = MitsubaRenderer(scene, camera, settings)
     doc = {"scene": scene.name, "center": renderer.center.tolist(), "variant": renderer.variant,
            "render": asdict(settings), "seed": settings.seed, **(meta or {})}
     with DatasetWriter(out, renderer.camera, doc, overwrite) as writer:
@@ -48,10 +48,7 @@ def capture_dataset(scene: Scene, camera: UAVCamera, viewpoints: Sequence[Viewpo
 def scan_dataset(config: ScanConfig) -> Path:
     """Render the scan `config` describes (`nbv scan`) and return the dataset folder."""
     views = config.viewpoints()
-    meta = {"plan": {"name": config.plan, "radius": config.radius, "end_overlap": config.end_overlap,
-                     "side_overlap": config.side_overlap, "views": len(views),
-                     "elevation_deg": config.elevation},
-            "up_axis": config.scene.up_axis}
+    meta = {"plan": plan_record(config.plan, len(views)), "up_axis": config.scene.up_axis,
+            **run_record("nbv scan", config)}
     return capture_dataset(config.scene.load(), config.camera, views, config.out,
-                           replace(config.render, seed=config.seed), config.render.variant, meta,
-                           config.overwrite)
+                           replace(config.render, seed=config.seed), meta, config.overwrite)

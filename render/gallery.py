@@ -37,7 +37,7 @@ class GalleryConfig(MeshOrientation):
     """How views are rendered."""
     radius: float = 2.0
     """Camera distance from the scene centre, metres."""
-    elevation: float = 25.0
+    elevation_deg: float = 25.0
     """Camera elevation, degrees."""
 
     def scenes(self) -> SceneSet:
@@ -52,7 +52,7 @@ def render_gallery(config: GalleryConfig) -> Path:
         renderer = MitsubaRenderer(spec.load(), config.camera, config.render)
         views = []
         for k, azimuth in enumerate(AZIMUTHS_DEG):
-            view = Viewpoint(config.radius, math.radians(azimuth), math.radians(config.elevation))
+            view = Viewpoint(config.radius, math.radians(azimuth), math.radians(config.elevation_deg))
             views.append(renderer.render_rgb(viewpoint_to_c2w(view, renderer.center), seed=k))
         row = Image.fromarray(np.concatenate(views, axis=1))
         ImageDraw.Draw(row).text((6, 4), spec.scene, fill=(0, 0, 0))

@@ -50,10 +50,9 @@ class MitsubaRenderer:
         >>> rgb, depth = r.render(viewpoint_to_c2w(Viewpoint(2.0, 0.3, 0.4), r.center))
     """
 
-    def __init__(self, scene: Scene, camera: UAVCamera, settings: RenderSettings | None = None,
-                 variant: str | None = None) -> None:
+    def __init__(self, scene: Scene, camera: UAVCamera, settings: RenderSettings | None = None) -> None:
         self.settings = settings or RenderSettings()
-        self.mi = select_variant(variant or self.settings.variant)
+        self.mi = select_variant(self.settings.variant)
         self.variant: str = self.mi.variant()
         self.camera = self.settings.render_camera(camera)
         self.center = scene.center() if scene.parts else np.zeros(3)

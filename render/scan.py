@@ -16,9 +16,11 @@ single view at the pole (if the rings reach it) comes last.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Any
+
+from tyro.conf import subcommand
 
 from render.camera import UAVCamera
 from render.settings import RenderSettings
@@ -137,6 +139,23 @@ def circle_scan(camera: UAVCamera, plan: CirclePlan = CirclePlan()) -> list[View
     return ring(plan.radius, elevation, count)
 
 
+ScanPlan = Annotated[HemispherePlan, subcommand("hemisphere")] | Annotated[CirclePlan, subcommand("circle")]
+"""A scan plan, chosen on the command line as a subcommand (`nbv scan SCENE circle --views 8`)."""
+
+
+def plan_record(plan: HemispherePlan | CirclePlan, views: int) -> dict[str, Any]:
+    """A scan plan as recorded in its dataset's `nbv.plan`: its name, its fields and the view count."""
+    name = "hemisphere" if isinstance(plan, HemispherePlan) else "circle"
+    return {"name": name, **asdict(plan), "views": views}
+
+
+def plan_viewpoints(camera: UAVCamera, plan: HemispherePlan | CirclePlan) -> list[Viewpoint]:
+    """The viewpoints a scan plan asks for."""
+    if isinstance(plan, HemispherePlan):
+        return hemisphere_scan(camera, plan)
+    return circle_scan(camera, plan)
+
+
 @dataclass(frozen=True, kw_only=True)
 class ScanConfig:
     """Settings of `nbv scan`: a scene, a camera, how to render, and the scan plan."""
@@ -149,32 +168,18 @@ class ScanConfig:
     """The camera."""
     render: RenderSettings = RenderSettings()
     """How views are rendered."""
-    plan: Literal["hemisphere", "circle"] = "hemisphere"
-    """Scan plan: full-coverage hemisphere (paper Sec. V-B) or one circle."""
-    radius: float = 2.0
-    """Camera distance from the scene centre, metres; at least 1 (outside the normalised target) and at
-    most far_m - 1."""
-    end_overlap: float = 0.86
-    """Overlap of consecutive images along a ring (hemisphere; circle when --views is not given)."""
-    side_overlap: float = 0.8
-    """Overlap of images on neighbouring rings (hemisphere)."""
-    views: int | None = None
-    """Number of views (circle, 1 to 100000); default: derived from --end-overlap."""
-    elevation: float = 30.0
-    """Elevation of the circle, degrees (circle)."""
+    plan: ScanPlan = HemispherePlan()
+    """Scan plan: the full-coverage hemisphere (paper Sec. V-B; the default) or one circle."""
     seed: int = 0
     """Base seed of the per-view render seeds."""
     overwrite: bool = False
     """Replace an existing non-empty output folder (only once the new scan is complete)."""
 
     def __post_init__(self) -> None:
-        check_camera_distance("radius", self.radius, self.camera)
-        if self.views is not None:
-            check_views("views", self.views)
+        check_camera_distance("radius", self.plan.radius, self.camera)
+        if isinstance(self.plan, CirclePlan) and self.plan.views is not None:
+            check_views("views", self.plan.views)
 
     def viewpoints(self) -> list[Viewpoint]:
         """The viewpoints the plan asks for."""
-        if self.plan == "hemisphere":
-            plan = HemispherePlan(self.radius, self.end_overlap, self.side_overlap)
-            return hemisphere_scan(self.camera, plan)
-        return circle_scan(self.camera, CirclePlan(self.radius, self.elevation, self.views, self.end_overlap))
+        return plan_viewpoints(self.camera, self.plan)

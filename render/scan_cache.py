@@ -20,7 +20,7 @@ from common.io import cache_dir
 from render.camera import UAVCamera
 from render.capture import capture_dataset
 from render.dataset import DatasetError, ViewDataset, read_dataset
-from render.scan import HemispherePlan, hemisphere_scan
+from render.scan import HemispherePlan, hemisphere_scan, plan_record
 from render.settings import RenderSettings
 from render.variant import select_variant
 from render.viewpoint import Viewpoint
@@ -49,21 +49,20 @@ def scan_key(scene: Scene, camera: UAVCamera, viewpoints: Sequence[Viewpoint], s
 
 
 def ensure_scan(scene: Scene, camera: UAVCamera, viewpoints: Sequence[Viewpoint], folder: str | Path,
-                settings: RenderSettings = RenderSettings(), variant: str | None = None,
-                meta: dict | None = None, fresh: bool = False, progress: bool = True) -> ViewDataset:
+                settings: RenderSettings = RenderSettings(), meta: dict | None = None, fresh: bool = False,
+                progress: bool = True) -> ViewDataset:
     """The scan of `viewpoints` at `folder`, rendered now unless an identical one is already there."""
     folder = Path(folder)
-    key = scan_key(scene, camera, viewpoints, settings, select_variant(variant).variant())
+    key = scan_key(scene, camera, viewpoints, settings, select_variant(settings.variant).variant())
     if fresh or _stored_key(folder) != json.loads(json.dumps(key)):
-        capture_dataset(scene, camera, viewpoints, folder, settings, key["variant"],
-                        {**(meta or {}), "scan_key": key}, overwrite=True, progress=progress)
+        capture_dataset(scene, camera, viewpoints, folder, settings, {**(meta or {}), "scan_key": key},
+                        overwrite=True, progress=progress)
     return read_dataset(folder)
 
 
 def full_scan(scene: Scene, camera: UAVCamera, folder: str | Path | None = None,
-              settings: RenderSettings = RenderSettings(), variant: str | None = None,
-              plan: HemispherePlan = HemispherePlan(), fresh: bool = False,
-              progress: bool = True) -> ViewDataset:
+              settings: RenderSettings = RenderSettings(), plan: HemispherePlan = HemispherePlan(),
+              fresh: bool = False, progress: bool = True) -> ViewDataset:
     """The full-coverage hemisphere scan (288 views by default; paper Sec. V-B).
 
     Args:
@@ -73,8 +72,8 @@ def full_scan(scene: Scene, camera: UAVCamera, folder: str | Path | None = None,
     if folder is None:
         safe = "".join(c if c.isalnum() or c in "_-" else "_" for c in scene.name)[:40]
         folder = cache_dir() / "scans" / f"{safe}-{scene_digest(scene)}-{camera.width}x{camera.height}"
-    meta = {"plan": {"name": "hemisphere", **asdict(plan), "views": len(viewpoints)}}
-    return ensure_scan(scene, camera, viewpoints, folder, settings, variant, meta, fresh, progress)
+    meta = {"plan": plan_record(plan, len(viewpoints))}
+    return ensure_scan(scene, camera, viewpoints, folder, settings, meta, fresh, progress)
 
 
 def _stored_key(folder: Path) -> dict | None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 from nbv.bench import BenchResult
 from render.camera import UAVCamera
@@ -25,7 +26,7 @@ def measure(variant: str, width: int, height: int, views: int,
     """Seconds of the first RGB-D view (scene load included) and mean seconds of `views` more."""
     scene = load_scene(DEFAULT_SCENE)
     start = time.perf_counter()
-    renderer = MitsubaRenderer(scene, UAVCamera(width, height), settings, variant)
+    renderer = MitsubaRenderer(scene, UAVCamera(width, height), replace(settings, variant=variant))
     renderer.render(viewpoint_to_c2w(Viewpoint(2.0, 0.0, 0.4), renderer.center))
     first = time.perf_counter() - start
     start = time.perf_counter()

@@ -85,7 +85,8 @@ def lattice_vs_render(config: EnvConfig, steps: int) -> list[BenchResult]:
     one-time build per scene is timed on an empty cache and reported apart.
     """
     train = replace(config, camera=UAVCamera(160, 120), render=replace(config.render, spp=4),
-                    bov=replace(config.bov, features="opencv"), action_mode="orbit")
+                    bov=replace(config.bov, sift=replace(config.bov.sift, backend="opencv")),
+                    action_mode="orbit")
     on_lattice = replace(train, lattice=LatticeConfig(enabled=True))
     rendering = env_steps_per_s(train, 1, steps)
     scene = on_lattice.scenes.specs()[0].load()
@@ -116,7 +117,8 @@ def run(quick: bool) -> list[BenchResult]:
     updates = sac_updates_per_s(config, 5 if quick else 50)
     results.append(BenchResult("rl", "SAC updates/s, batch 8, 64x64 frames", updates, "updates/s"))
     for backend in ("kornia", "opencv"):
-        stages = planning_ms(replace(config, bov=replace(config.bov, features=backend)), 3 if quick else 12)
+        sift = replace(config.bov.sift, backend=backend)
+        stages = planning_ms(replace(config, bov=replace(config.bov, sift=sift)), 3 if quick else 12)
         for stage, ms in stages.items():
             results.append(BenchResult("rl", f"planning {stage} ms/step ({backend} SIFT)", ms, "ms"))
         total = sum(stages.values())

@@ -31,6 +31,7 @@ from torchrl.envs.utils import ExplorationType, set_exploration_type
 from common.threads import limit_torch_threads, worker_threads
 from nbv.bench import BenchResult
 from nbv.bench.bov import render_views
+from nbv.bov.bag import BagOfViews
 from nbv.features.sift import FeatureConfig, extract_features
 from nbv.rl.agent import make_actor
 from nbv.rl.config import EnvConfig
@@ -119,7 +120,7 @@ def planning_step_ms(images: np.ndarray, config: EnvConfig, repeats: int) -> dic
     best = {"total": math.inf}
     with torch.no_grad(), set_exploration_type(ExplorationType.DETERMINISTIC):
         for p in range(repeats + 1):
-            bov = config.bov.bag(seed=p)
+            bov = BagOfViews.from_config(config.bov, seed=p)
             stages = {"features": 0.0, "bov": 0.0, "policy": 0.0}
             for i, rgb in enumerate(images):
                 t0 = time.perf_counter()
@@ -143,8 +144,8 @@ def bench_planning(images: np.ndarray, repeats: int) -> list[BenchResult]:
     """The planning step (and its stages) at the policy's threads, idle and busy, beside the goals."""
     camera = UAVCamera(images.shape[2], images.shape[1])
     config = EnvConfig(scenes=SceneSet(scene=(DEFAULT_SCENE,)), camera=camera)
-    label = (f"planning step {images.shape[2]}x{images.shape[1]} ({config.bov.features} SIFT + BoV reward + "
-             f"policy, no render, {worker_threads()} torch thread)")
+    label = (f"planning step {images.shape[2]}x{images.shape[1]} ({config.bov.sift.backend} SIFT + BoV "
+             f"reward + policy, no render, {worker_threads()} torch thread)")
     ms, results = {}, []
     with limit_torch_threads(worker_threads()):
         for kind in LOADS:

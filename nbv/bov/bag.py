@@ -38,7 +38,7 @@ Rules (docs/bov.md, where the paper is open):
   Identical vocabularies give -K, so an uninformative view earns -K - 1.
 
 Hand-worked toy (N = 2 ranges [0, pi) and [pi, 2pi), W = 1, 4-d descriptors,
-e_i the unit vectors, the paper's c = 0.5; tested in tests/nbv/test_bov.py):
+e_i the unit vectors, the paper's c = 0.5; tested in tests/nbv/bov/test_bag.py):
 
 =====  =======  ========  =============================  =======================
 view   azimuth  features  score                          decision, range 0 word
@@ -66,7 +66,13 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from nbv.bov.config import DEFAULT_MATCH_COSINE
+from nbv.bov.config import (
+    DEFAULT_KMEANS_ITERS,
+    DEFAULT_MATCH_COSINE,
+    DEFAULT_MEMORY_CAP,
+    BoVConfig,
+    BoVRule,
+)
 from nbv.bov.kmeans import spherical_kmeans
 from render.viewpoint import TWO_PI
 
@@ -239,8 +245,9 @@ class BagOfViews(nn.Module):
         -0.4142
     """
 
-    def __init__(self, ranges: int, words: int, memory_cap: int = 2048, seed: int = 0,
-                 device: str | torch.device | None = None, dim: int = 128, kmeans_iters: int = 10,
+    def __init__(self, ranges: int, words: int, memory_cap: int = DEFAULT_MEMORY_CAP, seed: int = 0,
+                 device: str | torch.device | None = None, dim: int = 128,
+                 kmeans_iters: int = DEFAULT_KMEANS_ITERS,
                  match_cosine: float = DEFAULT_MATCH_COSINE, bands: int = 1,
                  elevation_bounds: tuple[float, float] | None = None) -> None:
         super().__init__()
@@ -266,6 +273,24 @@ class BagOfViews(nn.Module):
         self.register_buffer("memory_count", torch.zeros(ranges, dtype=torch.long, device=device))
         self.register_buffer("seen", torch.zeros(ranges, dtype=torch.long, device=device))
         self.register_buffer("updates", torch.zeros(ranges, dtype=torch.long, device=device))
+
+    @classmethod
+    def from_rule(cls, rule: BoVRule, ranges: int, words: int, seed: int = 0,
+                  device: str | torch.device | None = None, dim: int = 128, bands: int = 1,
+                  elevation_bounds: tuple[float, float] | None = None) -> BagOfViews:
+        """An empty Bag of Views of N = `ranges` (x E = `bands`) vocabularies of W = `words` words
+        under `rule` (its match cosine, memory cap and k-means rounds)."""
+        return cls(ranges, words, rule.memory_cap, seed=seed, device=device, dim=dim,
+                   kmeans_iters=rule.kmeans_iters, match_cosine=rule.match_cosine, bands=bands,
+                   elevation_bounds=elevation_bounds)
+
+    @classmethod
+    def from_config(cls, config: BoVConfig, seed: int = 0, device: str | torch.device | None = None,
+                    elevation_bounds: tuple[float, float] | None = None) -> BagOfViews:
+        """An empty Bag of Views of `config`'s size and rule (`elevation_bounds`, radians, split into
+        its E bands)."""
+        return cls.from_rule(config, config.ranges, config.words, seed, device,
+                             bands=config.elevation_bands, elevation_bounds=elevation_bounds)
 
     def extra_repr(self) -> str:
         return (f"ranges={self.azimuth_ranges}, bands={self.bands}, words={self.num_words}, "

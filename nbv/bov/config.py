@@ -1,22 +1,23 @@
 """The Bag of Views config, declared once: refinement, the sweep, the RL reward and the greedy planner.
 
-Light on purpose (no torch), so the command line builds its parser without
-loading the models. `docs/bov.md` states the rule these knobs control.
+Light on purpose (no torch), so the command line builds its parser without loading
+the models. `docs/bov.md` states the rule these knobs control; `BagOfViews.from_rule`
+and `BagOfViews.from_config` (`nbv.bov.bag`) build a Bag of Views from them.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Annotated, Literal
+from dataclasses import dataclass, replace
+from typing import Any
 
-from tyro.conf import arg
-
-if TYPE_CHECKING:
-    from nbv.bov.bag import BagOfViews
-    from nbv.features.sift import FeatureConfig
+from nbv.features.config import FeatureConfig
 
 DEFAULT_MATCH_COSINE = 0.8
 """c of d = 1 - cos / c; measured on our SIFT scans (docs/bov.md §4). 0.5 is the paper's Eq. 1."""
+DEFAULT_MEMORY_CAP = 2048
+"""Descriptors held per azimuth range by default."""
+DEFAULT_KMEANS_ITERS = 10
+"""Most Lloyd rounds of one vocabulary update by default."""
 MAX_RANGES = 360
 """Most azimuth ranges N (one per degree); more only allocates empty vocabularies."""
 MAX_WORDS = 10_000
@@ -30,36 +31,34 @@ class BoVRule:
     match_cosine: float = DEFAULT_MATCH_COSINE
     """c of d = 1 - cos / c: a descriptor is new below this cosine to its nearest word (0.5: the paper's
     d = 1 - 2 cos, which keeps one view per range on SIFT; see docs/bov.md)."""
-    memory_cap: Annotated[int, arg(aliases=("--bov-memory",))] = 2048
+    memory_cap: int = DEFAULT_MEMORY_CAP
     """Descriptors held per azimuth range (reservoir sample) for the k-means updates."""
-    kmeans_iters: int = 10
+    kmeans_iters: int = DEFAULT_KMEANS_ITERS
     """Most Lloyd rounds of one k-means update of a range's words."""
-    features: Annotated[Literal["kornia", "opencv"], arg(aliases=("--feature-backend",))] = "kornia"
-    """SIFT backend."""
-    max_features: int = 500
-    """Keypoints kept per view, strongest first."""
+    sift: FeatureConfig = FeatureConfig()
+    """The SIFT features the rule counts: backend, keypoints per view, contrast threshold, doubling."""
 
     def __post_init__(self) -> None:
         if not 0.0 < self.match_cosine <= 1.0:
             raise ValueError(f"match_cosine must lie in (0, 1], got {self.match_cosine}")
-        for name in ("memory_cap", "kmeans_iters", "max_features"):
+        for name in ("memory_cap", "kmeans_iters"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
 
     def feature_config(self, device: str = "cpu") -> FeatureConfig:
-        """The SIFT extraction settings."""
-        from nbv.features.sift import FeatureConfig
+        """The SIFT extraction settings, on the torch `device` of the command."""
+        return replace(self.sift, device=device)
 
-        return FeatureConfig(backend=self.features, max_features=self.max_features, device=device)
-
-    def make_bag(self, ranges: int, words: int, seed: int = 0, device: str = "cpu", bands: int = 1,
-                 elevation_bounds: tuple[float, float] | None = None) -> BagOfViews:
-        """An empty Bag of Views of N = `ranges` (x E = `bands`) vocabularies of W = `words` words."""
-        from nbv.bov.bag import BagOfViews
-
-        return BagOfViews(ranges, words, self.memory_cap, seed=seed, device=device,
-                          kmeans_iters=self.kmeans_iters, match_cosine=self.match_cosine, bands=bands,
-                          elevation_bounds=elevation_bounds)
+    @staticmethod
+    def upgrade_record(record: dict[str, Any]) -> dict[str, Any]:
+        """A record written before the SIFT settings were nested (top-level `features` and
+        `max_features`, e.g. the shipped policy's) in today's layout; today's records pass unchanged."""
+        moved = {"features": "backend", "max_features": "max_features"}
+        if not set(moved) & set(record):
+            return record
+        sift = {new: record[old] for old, new in moved.items() if old in record}
+        kept = {k: v for k, v in record.items() if k not in moved}
+        return {**kept, "sift": {**sift, **kept.get("sift", {})}}
 
 
 def check_size(ranges: int, words: int) -> None:
@@ -73,9 +72,9 @@ def check_size(ranges: int, words: int) -> None:
 class BoVConfig(BoVRule):
     """A Bag of Views of a given size under the rule (paper Table 2's N and W)."""
 
-    ranges: Annotated[int, arg(aliases=("--bov-ranges",))] = 9
+    ranges: int = 9
     """N, azimuth ranges (vocabularies) of the Bag of Views."""
-    words: Annotated[int, arg(aliases=("--bov-words",))] = 20
+    words: int = 20
     """W, visual words per range."""
     elevation_bands: int = 1
     """E, elevation bands per azimuth range of the online reward (1: the paper's azimuth-only ranges; 2
@@ -86,8 +85,3 @@ class BoVConfig(BoVRule):
         if self.elevation_bands < 1:
             raise ValueError(f"elevation_bands must be >= 1, got {self.elevation_bands}")
         check_size(self.ranges * self.elevation_bands, self.words)
-
-    def bag(self, seed: int = 0, device: str = "cpu",
-            elevation_bounds: tuple[float, float] | None = None) -> BagOfViews:
-        """An empty Bag of Views of this size (`elevation_bounds`, radians, split into the E bands)."""
-        return self.make_bag(self.ranges, self.words, seed, device, self.elevation_bands, elevation_bounds)

@@ -22,11 +22,12 @@ import torch
 from tyro.conf import Positional, arg
 
 from common.io import check_separate
-from common.provenance import config_record
-from nbv.bov.bag import DEFAULT_MATCH_COSINE, BagOfViews
+from common.provenance import config_record, run_record
+from common.threads import set_torch_threads
+from nbv.bov.bag import BagOfViews
 from nbv.bov.config import BoVConfig, BoVRule
 from nbv.features.cache import dataset_features
-from nbv.features.sift import Features
+from nbv.features.sift import DESCRIPTOR_DIM, Features
 from render.dataset import ViewDataset, check_output_folder, read_dataset, write_subset
 from render.viewpoint import c2w_to_viewpoint
 
@@ -98,34 +99,24 @@ def frame_azimuths(dataset: ViewDataset) -> np.ndarray:
                      else c2w_to_viewpoint(f.c2w, dataset.center).azimuth for f in dataset.frames])
 
 
-def refine_views(descriptors: Sequence[torch.Tensor], azimuths: Sequence[float], ranges: int,
-                 words: int, memory_cap: int = 2048, seed: int = 0,
-                 device: str | torch.device | None = None,
-                 match_cosine: float = DEFAULT_MATCH_COSINE, kmeans_iters: int = 10) -> RefineResult:
-    """Paper Alg. 1 over views in order: keep iff score > 0, update only with kept views.
+def refine_views(descriptors: Sequence[torch.Tensor], azimuths: Sequence[float],
+                 bov: BagOfViews) -> RefineResult:
+    """Paper Alg. 1 over views in order into the (empty) Bag of Views `bov`: keep iff score > 0, update
+    only with kept views.
 
     Args:
         descriptors: per view, its (M, D) descriptors.
         azimuths: per view, its azimuth in radians.
-        ranges: N.
-        words: W.
-        memory_cap: descriptors held per range.
-        seed: seed of the Bag of Views.
-        device: torch device of the Bag of Views.
-        match_cosine: c of the dissimilarity d = 1 - cos / c.
-        kmeans_iters: most Lloyd rounds of one vocabulary update.
+        bov: the Bag of Views the kept views fill (N, W and the rule are its own).
 
     Example:
         >>> e = torch.eye(4)
-        >>> refine_views([e[:2], e[:1], e[:0], e[2:3], e[3:4]], [0.5, 1.0, 4.0, 2.0, 3.5], 2, 1,
-        ...              match_cosine=0.5).kept
+        >>> refine_views([e[:2], e[:1], e[:0], e[2:3], e[3:4]], [0.5, 1.0, 4.0, 2.0, 3.5],
+        ...              BagOfViews(2, 1, dim=4, match_cosine=0.5)).kept
         [0, 3, 4]
     """
     if len(descriptors) != len(azimuths):
         raise ValueError(f"{len(descriptors)} views but {len(azimuths)} azimuths")
-    dim = descriptors[0].shape[-1] if len(descriptors) else 128
-    bov = BagOfViews(ranges, words, memory_cap=memory_cap, seed=seed, device=device, dim=dim,
-                     kmeans_iters=kmeans_iters, match_cosine=match_cosine)
     kept, scores = [], []
     for i, (desc, azimuth) in enumerate(zip(descriptors, azimuths)):
         score = bov.score(desc, float(azimuth))  # Alg. 1 lines 6-9
@@ -138,9 +129,9 @@ def refine_views(descriptors: Sequence[torch.Tensor], azimuths: Sequence[float],
 
 def refine_with(rule: BoVRule, descriptors: Sequence[torch.Tensor], azimuths: Sequence[float], ranges: int,
                 words: int, seed: int = 0, device: str | torch.device | None = None) -> RefineResult:
-    """`refine_views` with a Bag of Views of N = `ranges`, W = `words` under `rule`."""
-    return refine_views(descriptors, azimuths, ranges, words, rule.memory_cap, seed, device,
-                        rule.match_cosine, rule.kmeans_iters)
+    """`refine_views` with a fresh Bag of Views of N = `ranges`, W = `words` under `rule`."""
+    dim = descriptors[0].shape[-1] if len(descriptors) else DESCRIPTOR_DIM
+    return refine_views(descriptors, azimuths, BagOfViews.from_rule(rule, ranges, words, seed, device, dim))
 
 
 def load_views(run: DatasetRun, rule: BoVRule, progress: Progress | None = None
@@ -149,8 +140,8 @@ def load_views(run: DatasetRun, rule: BoVRule, progress: Progress | None = None
     if run.device.startswith("cuda") and int(run.device.partition(":")[2] or 0) >= torch.cuda.device_count():
         raise ValueError(f"device {run.device!r}: torch sees {torch.cuda.device_count()} CUDA GPU(s) here")
     dataset = read_dataset(run.dataset)
-    if run.threads > 0:
-        torch.set_num_threads(run.threads)
+    if run.threads > 0:  # 0 leaves the process's choice (or the thread policy) as it was
+        set_torch_threads(run.threads)
     feats = dataset_features(dataset, rule.feature_config(run.device), run.cache_dir, progress)
     return dataset, feats, frame_azimuths(dataset)
 
@@ -177,7 +168,8 @@ def refine_dataset(config: RefineConfig, progress: Progress | None = None) -> di
                "kept": result.kept, "scores": [_json_score(s) for s in result.scores],
                "ranges": result.ranges, "settings": settings,
                "seconds": round(time.perf_counter() - start, 3),
-               "note": "scores: null is +inf (first view of an empty range); a view is kept iff score > 0"}
+               "note": "scores: null is +inf (first view of an empty range); a view is kept iff score > 0",
+               **run_record("nbv refine", config)}
     write_subset(dataset, result.kept, out, {"refine": {"source": str(config.dataset), **settings}},
                  config.overwrite, extra={"refine.json": summary})
     return summary

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from common.io import atomic_folder, atomic_path, markdown_table, write_json, write_text
+from common.provenance import run_record
 from nbv.bov.config import BoVRule, check_size
 from nbv.bov.refine import DatasetRun, Progress, RefineResult, kept_view_grid, load_views
 
@@ -63,7 +64,7 @@ def sweep(config: SweepConfig, progress: Progress | None = None,
     doc = {"dataset": str(config.dataset), "source_views": len(dataset), "grid": rows,
            "kept": {f"{n},{w}": r.kept for (n, w), r in grid.items()},
            "settings": config.settings(config.rule),
-           "seconds": round(time.perf_counter() - start, 3)}
+           "seconds": round(time.perf_counter() - start, 3), **run_record("nbv refine-sweep", config)}
     with atomic_folder(config.out, overwrite=True, outputs=OUTPUTS) as folder:  # the three files together
         write_csv(folder / "sweep.csv", rows)
         write_text(folder / "sweep.md", sweep_markdown(rows, str(config.dataset)))

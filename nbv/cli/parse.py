@@ -7,20 +7,29 @@ when the parser is built (a test builds every command's parser). Field
 docstrings are the `--help` text. A value a config's `__post_init__` refuses
 surfaces as its one-line ValueError (exit status 2 in `nbv.cli.main`), not as
 tyro's error box.
+
+`--config RECORD` (any command) starts from the whole config recorded in a run record
+(`plan.json`, `metrics.json`, `refine.json`, `reconstruction.json`, `sweep.json`, a scan's
+`transforms.json`; `common.provenance.run_record`), and the other flags override it:
+`nbv plan --config old/plan.json --out new` re-runs a plan into `new`.
 """
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Sequence
 from typing import TypeVar
 
 import tyro
 from tyro._errors import InstantiationFailure, ParseErrorEvent, on_parse_error  # tyro is pinned exactly
 
+from common.provenance import recorded_config
+
 T = TypeVar("T")
 
-MARKERS = (tyro.conf.OmitArgPrefixes,)
-"""How every command's config becomes options: flat names, nested groups in `--help`."""
+MARKERS = (tyro.conf.OmitArgPrefixes, tyro.conf.CascadeSubcommandArgs)
+"""How every command's config becomes options: flat names, nested groups in `--help`, and a command's
+own options accepted after a subcommand (`nbv scan SCENE circle --views 8 --out DIR`)."""
 
 
 def _refused_value(event: ParseErrorEvent) -> None:
@@ -29,9 +38,38 @@ def _refused_value(event: ParseErrorEvent) -> None:
         raise ValueError(event.message)
 
 
+CONFIG_HELP = ("--config RECORD: start from the config recorded in RECORD (this command's plan.json, "
+               "metrics.json, refine.json, reconstruction.json, sweep.json or a scan's transforms.json); "
+               "the other options override it.")
+"""What `--help` says about `--config` (it is taken before tyro sees the options)."""
+
+
+def split_config(args: Sequence[str]) -> tuple[str | None, list[str]]:
+    """`args` without their `--config PATH` (or `--config=PATH`), and PATH (None if not given).
+
+    Example:
+        >>> split_config(["DATASET", "--config", "run/refine.json", "--ranges", "3"])
+        ('run/refine.json', ['DATASET', '--ranges', '3'])
+    """
+    rest, path = list(args), None
+    for i, arg in enumerate(rest):
+        if arg == "--config":
+            if i + 1 == len(rest):
+                raise ValueError("--config needs a run record file (e.g. out/plan.json)")
+            path = rest[i + 1]
+            return path, rest[:i] + rest[i + 2:]
+        if arg.startswith("--config="):
+            return arg.partition("=")[2], rest[:i] + rest[i + 1:]
+    return path, rest
+
+
 def parse(cls: type[T], args: Sequence[str], prog: str, default: T | None = None,
           description: str | None = None) -> T:
-    """The config `cls` from command-line `args` (`--help` prints the options and exits)."""
+    """The config `cls` from command-line `args` (`--help` prints the options and exits); with
+    `--config RECORD`, the recorded config is the default the other options override."""
+    record, args = split_config(args)
+    if record is not None:
+        default = recorded_config(cls, record, prog)
+    text = f"{(description or inspect.getdoc(cls) or '').strip()}\n\n{CONFIG_HELP}"
     with on_parse_error(_refused_value):
-        return tyro.cli(cls, args=list(args), prog=prog, default=default, description=description,
-                        config=MARKERS)
+        return tyro.cli(cls, args=args, prog=prog, default=default, description=text, config=MARKERS)

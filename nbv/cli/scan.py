@@ -1,4 +1,7 @@
-"""`nbv scan SCENE --plan {hemisphere,circle} --out DIR`: render a scan plan into a view dataset."""
+"""`nbv scan SCENE [hemisphere|circle] [PLAN FLAGS] --out DIR`: render a scan plan into a view dataset.
+
+The plan is a subcommand (default: hemisphere), each with its own flags: `nbv scan SCENE circle --help`.
+"""
 
 from __future__ import annotations
 

@@ -35,7 +35,7 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 from PIL import Image
-from tyro.conf import UseAppendAction, arg
+from tyro.conf import UseAppendAction
 
 from common.io import atomic_path, cache_dir, write_json
 from common.provenance import git_commit, run_cache
@@ -90,7 +90,7 @@ class AblateConfig(MeshOrientation):
     """Samples per pixel of the reference render of the quality views."""
     quality_views: int = 4
     """Scan views (evenly spread) scored by PSNR, SSIM, repeatability and matching."""
-    tolerance_px: Annotated[float, arg(aliases=("--match-tolerance-px",))] = 1.5
+    tolerance_px: float = 1.5
     """Repeatability and match radius, pixels of the reference render."""
     greedy_views: int = 13
     """Views of the greedy Bag of Views plan scored on lighting axes (paper Fig. 1's count)."""

@@ -52,5 +52,4 @@ class FullScanStudy(MeshOrientation):
         """The full hemisphere scan of `scene`, rendered with the study's seed unless already cached."""
         from render.scan_cache import full_scan
 
-        return full_scan(scene, self.camera, folder, replace(self.render, seed=self.seed),
-                         self.render.variant, self.plan, fresh)
+        return full_scan(scene, self.camera, folder, replace(self.render, seed=self.seed), self.plan, fresh)

@@ -6,7 +6,7 @@ Names are re-exported lazily (`common.lazy`), so importing a config module stays
 from common.lazy import lazy_exports
 
 _EXPORTS = {
-    "FeatureConfig": "nbv.features.sift",
+    "FeatureConfig": "nbv.features.config",
     "Features": "nbv.features.sift",
     "extract_features": "nbv.features.sift",
     "dataset_features": "nbv.features.cache",

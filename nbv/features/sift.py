@@ -28,7 +28,6 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Literal
 
 import cv2
 import kornia.feature as KF
@@ -37,38 +36,12 @@ import torch
 from kornia.color import rgb_to_grayscale
 from kornia.feature.sift.scale_space import _SIFTScalePyramid
 
+from nbv.features.config import FeatureConfig
+
 DESCRIPTOR_DIM = 128
 """Length of a SIFT descriptor."""
 OCTAVE_LAYERS = 3
 """SIFT intervals per octave (Lowe 2004; OpenCV's and Kornia's default)."""
-
-
-@dataclass(frozen=True)
-class FeatureConfig:
-    """Settings of SIFT extraction (all but `device` and `batch_size` key the feature cache)."""
-
-    backend: Literal["kornia", "opencv"] = "kornia"
-    """Feature extractor: Kornia (torch, batched, any device) or OpenCV (CPU)."""
-    max_features: int = 500
-    """Keep at most this many keypoints per view, the strongest by |DoG| response."""
-    contrast_threshold: float = 0.04
-    """OpenCV's SIFT contrast threshold; keypoints with |DoG| below it / 3 (image in [0, 1]) are dropped."""
-    double_image: bool = False
-    """Kornia: upsample the image 2x before the first octave (Lowe's octave -1; ~4x slower)."""
-    device: str = "cpu"
-    """Torch device of the Kornia backend and of the returned tensors."""
-    batch_size: int = 8
-    """Kornia: views per forward pass."""
-
-    def __post_init__(self) -> None:
-        if self.backend not in ("kornia", "opencv"):
-            raise ValueError(f"backend must be 'kornia' or 'opencv', got {self.backend!r}")
-        if self.max_features < 1:
-            raise ValueError(f"max_features must be >= 1, got {self.max_features}")
-        if self.contrast_threshold < 0:
-            raise ValueError(f"contrast_threshold must be >= 0, got {self.contrast_threshold}")
-        if self.batch_size < 1:
-            raise ValueError(f"batch_size must be >= 1, got {self.batch_size}")
 
 
 @dataclass(frozen=True)

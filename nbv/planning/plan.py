@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from common.io import atomic_folder, check_output_folder, write_json
-from common.provenance import config_record
+from common.provenance import config_record, run_record
 from common.threads import chosen_threads, limit_torch_threads, worker_threads
 from nbv.bov.config import BoVConfig
 from nbv.planning.planners import Planner, PolicyPlanner, make_planner
@@ -165,7 +165,7 @@ def reference_mesh(config: PlanSettings, scene: Scene | None = None) -> Path:
     env_config = scan_env_config(config)
     radius = (env_config.radius_min + env_config.radius_max) / 2.0
     full = full_scan(scene or config.scene.load(), config.camera, settings=config.render,
-                     variant=config.render.variant, plan=HemispherePlan(radius=radius), progress=False)
+                     plan=HemispherePlan(radius=radius), progress=False)
     folder = full.root / f"reconstruction_{config.recon.voxel_size_m * 1000:g}mm"
     key = config_record(config.recon)
     if not (folder / "mesh.ply").is_file() or _stored(folder / RECONSTRUCTION_KEY) != key:
@@ -194,7 +194,7 @@ def plan_scan(config: PlanConfig) -> dict:
     meta = {"planner": config.planner, "up_axis": config.scene.up_axis}
     with atomic_folder(out, config.overwrite) as folder:
         dataset = capture_dataset(scene, config.camera, views, folder / "views", settings,
-                                  config.render.variant, meta, overwrite=True, progress=False)
+                                  meta, overwrite=True, progress=False)
         recon = reconstruct_dataset(read_dataset(dataset), config.recon)
         save_reconstruction(recon, folder)
         scene.target_mesh().export(folder / "gt.ply")
@@ -209,7 +209,7 @@ def plan_scan(config: PlanConfig) -> dict:
         doc = {"planner": config.planner, "scene": config.scene.scene, "views": len(views),
                "planning_s": plan_s, "deciding_s": plan_s - camera_s,
                "viewpoints": [v.as_array().tolist() for v in views],
-               "config": config_record(config),
+               **run_record("nbv plan", config),
                **{name: result.as_dict() for name, result in results.items()}}
         write_json(folder / "plan.json", doc)
         poses = np.stack([viewpoint_to_c2w(v, scene.center()) for v in views])

@@ -73,7 +73,7 @@ class ReconstructionConfig:
 class MetricsConfig:
     """How surfaces are sampled and compared."""
 
-    n_points: Annotated[int, arg(aliases=("--metric-points",))] = 1_000_000
+    n_points: Annotated[int, arg(name="metric-points")] = 1_000_000
     """Points sampled from each surface (point clouds holding fewer are used whole)."""
     threshold_cm: float = 1.0
     """Distance threshold of coverage, precision, recall and F-score, in centimetres."""

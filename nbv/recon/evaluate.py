@@ -4,7 +4,8 @@ Writes DIR/metrics.json, one object per reference given under the keys
 `reference` (e.g. the full-scan reconstruction, as in the paper's Table 2) and
 `gt` (the ground-truth mesh), each with `chamfer_cm`, `hausdorff_cm`,
 `coverage`, `fscore`, `precision`, `recall`, `threshold_cm` and `n_points`;
-the inputs and settings are recorded under `run` (docs/data-formats.md §8).
+the inputs and settings are recorded under `run`, the run record (`commit`, `command`, the whole
+`config`; `nbv evaluate --config metrics.json` re-runs it) beside them (docs/data-formats.md §8).
 Also writes DIR/heatmap.png and DIR/heatmap.ply: distances to the reference,
 or to the ground truth when no reference is given (skipped when MESH is a
 point cloud; docs/reconstruction.md §6). The files are swapped into DIR together
@@ -21,6 +22,7 @@ import trimesh
 from tyro.conf import Positional, arg
 
 from common.io import atomic_folder, check_output_folder, write_json
+from common.provenance import run_record
 from nbv.recon.config import HeatmapConfig, MetricsConfig
 from nbv.recon.heatmap import write_heatmap
 from nbv.recon.metrics import Geometry, SurfaceMetrics, evaluate_surfaces, load_geometry
@@ -114,7 +116,8 @@ def write_evaluation(config: EvaluateConfig, prediction: Geometry, references: d
     run = {"mesh": str(config.mesh), "reference": None if config.reference is None else str(config.reference),
            "gt": gt.gt, "up_axis": gt.up_axis, "heatmap_against": heat_against if is_mesh else None,
            "metrics": asdict(metrics), "heatmap": asdict(config.heatmap)}
-    write_json(folder / "metrics.json", {**{name: m.as_dict() for name, m in results.items()}, "run": run})
+    write_json(folder / "metrics.json", {**{name: m.as_dict() for name, m in results.items()}, "run": run,
+                                         **run_record("nbv evaluate", config)})
     return results
 
 

@@ -7,13 +7,14 @@ rename (other files in OUT are kept), so an interrupted run leaves OUT as it was
 from __future__ import annotations
 
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any
 
 from tyro.conf import Positional, arg
 
 from common.io import atomic_folder, check_output_folder, check_separate, write_json
+from common.provenance import run_record
 from nbv.recon.config import ReconstructionConfig
 from nbv.recon.tsdf import reconstruct_dataset, save_reconstruction
 from render.dataset import read_dataset
@@ -50,7 +51,7 @@ def reconstruct(config: ReconstructConfig) -> dict[str, Any]:
     summary = {"dataset": str(config.dataset), "views": recon.n_views, "seconds": round(seconds, 3),
                "mesh": str(out / "mesh.ply"), "points": str(out / "points.ply"),
                "vertices": len(recon.mesh.vertices), "faces": len(recon.mesh.faces),
-               "n_points": len(recon.points.vertices), "config": asdict(config.recon)}
+               "n_points": len(recon.points.vertices), **run_record("nbv reconstruct", config)}
     with atomic_folder(out, config.overwrite, OUTPUTS) as folder:
         save_reconstruction(recon, folder)
         write_json(folder / "reconstruction.json", summary)

@@ -233,7 +233,7 @@ class NBVEnv(EnvBase):
         """The episode's Bag of Views (created on first use)."""
         if self._bov is None:
             bounds = (float(self.config.low[2]), float(self.config.high[2]))
-            self._bov = self.config.bov.bag(seed=self._seed, elevation_bounds=bounds)
+            self._bov = BagOfViews.from_config(self.config.bov, seed=self._seed, elevation_bounds=bounds)
         return self._bov
 
     @property

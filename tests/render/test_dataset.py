@@ -87,7 +87,8 @@ def test_backprojected_depth_lands_on_the_exported_mesh(tmp_path, variant):
     scene = load_scene("test_building")
     cam = UAVCamera(96, 72)
     views = hemisphere_scan(cam, HemispherePlan(end_overlap=0.3, side_overlap=0.2))
-    capture_dataset(scene, cam, views, tmp_path / "ds", RenderSettings(spp=1), variant, progress=False)
+    capture_dataset(scene, cam, views, tmp_path / "ds", RenderSettings(spp=1, variant=variant),
+                    progress=False)
     assert main(["scene", "export", "test_building", "--out", str(tmp_path / "gt")]) == 0
     mesh = trimesh.load(tmp_path / "gt" / "mesh.ply", force="mesh")
     points = backproject_from_files(tmp_path / "ds")

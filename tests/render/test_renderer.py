@@ -27,7 +27,7 @@ def marker_scene():
 
 def test_depth_of_a_fronto_parallel_plane_is_exact(variant):
     cam = UAVCamera(80, 60, 35.0)
-    renderer = MitsubaRenderer(marker_scene(), cam, RenderSettings(spp=1), variant)
+    renderer = MitsubaRenderer(marker_scene(), cam, RenderSettings(spp=1, variant=variant))
     c2w = viewpoint_to_c2w(Viewpoint(1.5, 0.7, np.pi / 2), np.zeros(3))
     depth = renderer.render_depth(c2w)
     # z-depth, not ray length: constant over the whole image (the marker sits 1 mm up).
@@ -38,7 +38,7 @@ def test_depth_of_a_fronto_parallel_plane_is_exact(variant):
 
 def test_a_known_point_projects_where_it_is_rendered(variant):
     cam = UAVCamera(160, 120, 35.0)
-    renderer = MitsubaRenderer(marker_scene(), cam, RenderSettings(spp=4, max_depth=2), variant)
+    renderer = MitsubaRenderer(marker_scene(), cam, RenderSettings(spp=4, max_depth=2, variant=variant))
     c2w = viewpoint_to_c2w(Viewpoint(1.2, 2.2, 1.1), np.zeros(3))
     rgb = renderer.render_rgb(c2w).astype(int)
     red = (rgb[..., 0] > 120) & (rgb[..., 1] < 60)
@@ -58,7 +58,8 @@ def test_scalar_and_llvm_depth_agree():
         pytest.skip("llvm_ad_rgb unavailable")
     scene, cam = load_scene("test_building"), UAVCamera(96, 72)
     c2w = viewpoint_to_c2w(Viewpoint(2.0, 0.9, 0.4), scene.center())
-    depths = [MitsubaRenderer(scene, cam, variant=v).render_depth(c2w) for v in ("scalar_rgb", "llvm_ad_rgb")]
+    depths = [MitsubaRenderer(scene, cam, RenderSettings(variant=v)).render_depth(c2w)
+              for v in ("scalar_rgb", "llvm_ad_rgb")]
     both = (depths[0] > 0) & (depths[1] > 0)
     assert both.mean() > 0.5
     assert np.median(np.abs(depths[0][both] - depths[1][both])) <= 1e-3
@@ -70,7 +71,7 @@ def test_a_new_pose_compiles_no_new_kernel_in_llvm():
         pytest.skip("llvm_ad_rgb unavailable")
     import drjit as dr
     scene = load_scene("test_building")
-    renderer = MitsubaRenderer(scene, UAVCamera(64, 48), RenderSettings(spp=2), "llvm_ad_rgb")
+    renderer = MitsubaRenderer(scene, UAVCamera(64, 48), RenderSettings(spp=2, variant="llvm_ad_rgb"))
     renderer.render(viewpoint_to_c2w(Viewpoint(2.0, 0.1, 0.3), renderer.center))
     dr.set_flag(dr.JitFlag.KernelHistory, True)
     try:

@@ -213,7 +213,29 @@ def test_elevation_bands_split_each_azimuth_range():
 def test_bov_config_elevation_bands():
     from nbv.bov.config import BoVConfig
 
-    bag = BoVConfig(ranges=8, words=5, elevation_bands=2).bag(elevation_bounds=(0.1, 1.3))
+    bag = BagOfViews.from_config(BoVConfig(ranges=8, words=5, elevation_bands=2), elevation_bounds=(0.1, 1.3))
     assert bag.ranges == 16 and bag.bands == 2
     with pytest.raises(ValueError, match="elevation_bands"):
         BoVConfig(elevation_bands=0)
+
+
+def test_a_bag_from_a_rule_takes_every_knob_of_the_rule():
+    from nbv.bov.config import BoVRule
+
+    bag = BagOfViews.from_rule(BoVRule(match_cosine=0.6, memory_cap=64, kmeans_iters=3), 5, 7, seed=2, dim=4)
+    assert (bag.ranges, bag.num_words, bag.memory_cap, bag.kmeans_iters) == (5, 7, 64, 3)
+    assert (bag.match_cosine, bag.seed, bag.dim, bag.bands) == (0.6, 2, 4, 1)
+
+
+def test_a_record_of_the_older_flat_feature_settings_reads_as_the_nested_ones():
+    from common.provenance import config_from_record, config_record
+    from nbv.bov.config import BoVConfig
+    from nbv.features.config import FeatureConfig
+
+    old = {"match_cosine": 0.8, "memory_cap": 2048, "kmeans_iters": 10, "features": "opencv",
+           "max_features": 300, "ranges": 8, "words": 20, "elevation_bands": 2}  # the shipped policy's layout
+    config = BoVConfig(ranges=8, elevation_bands=2, sift=FeatureConfig(backend="opencv", max_features=300))
+    assert config_from_record(BoVConfig, old) == config
+    assert config_from_record(BoVConfig, config_record(config)) == config
+    with pytest.raises(ValueError, match="no field"):
+        config_from_record(BoVConfig, {**old, "feature": "kornia"})

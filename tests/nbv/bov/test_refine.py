@@ -13,13 +13,16 @@ import pytest
 import torch
 from synthetic import write_circle_dataset
 
+from nbv.bov.bag import BagOfViews
 from nbv.bov.config import BoVConfig
 from nbv.bov.refine import RefineConfig, frame_azimuths, refine_dataset, refine_views
 from nbv.cli import main
+from nbv.features.config import FeatureConfig
 from render.dataset import DatasetError, read_dataset
 
 E = torch.eye(4)
 SMALL = ["--max-features", "40"]
+SIFT = FeatureConfig(max_features=40)
 
 
 @pytest.fixture(scope="module")
@@ -29,8 +32,8 @@ def source(tmp_path_factory) -> Path:
 
 
 def test_docstring_toy():
-    result = refine_views([E[:2], E[:1], E[:0], E[2:3], E[3:4]], [0.5, 1.0, 4.0, 2.0, 3.5], 2, 1,
-                          match_cosine=0.5)
+    result = refine_views([E[:2], E[:1], E[:0], E[2:3], E[3:4]], [0.5, 1.0, 4.0, 2.0, 3.5],
+                          BagOfViews(2, 1, dim=4, match_cosine=0.5))
     assert result.kept == [0, 3, 4] and result.ranges == [0, 0, 1, 0, 1]
     assert result.scores[0] == math.inf and result.scores[2] == 0.0
 
@@ -38,20 +41,20 @@ def test_docstring_toy():
 def test_first_view_kept_repeat_and_flat_dropped(source, tmp_path):
     cache = tmp_path / "cache"
     one = refine_dataset(RefineConfig(dataset=source, out=tmp_path / "one",
-                                      bov=BoVConfig(ranges=1, words=30, max_features=40), cache_dir=cache))
+                                      bov=BoVConfig(ranges=1, words=30, sift=SIFT), cache_dir=cache))
     assert one["kept"][0] == 0 and 1 not in one["kept"]  # an identical repeat brings nothing new
     assert 2 not in one["kept"] and 6 not in one["kept"]  # no keypoints: score 0, dropped
     assert one["scores"][0] is None and one["scores"][1] < 0 and one["scores"][2] == 0.0
     # One range per view: every view is the first of its range, kept unless it has no keypoints.
     each = refine_dataset(RefineConfig(dataset=source, out=tmp_path / "each",
-                                       bov=BoVConfig(ranges=8, words=30, max_features=40), cache_dir=cache))
+                                       bov=BoVConfig(ranges=8, words=30, sift=SIFT), cache_dir=cache))
     assert each["kept"] == [0, 1, 3, 4, 5, 7] and each["ranges"] == list(range(8))
     assert [s is None for s in each["scores"]] == [True, True, False, True, True, True, False, True]
 
 
 def test_refined_dataset_is_readable_and_traceable(source, tmp_path):
     out = tmp_path / "out"
-    bov = BoVConfig(ranges=2, words=5, max_features=40)
+    bov = BoVConfig(ranges=2, words=5, sift=SIFT)
     summary = refine_dataset(RefineConfig(dataset=source, out=out, bov=bov, cache_dir=tmp_path / "cache"))
     doc = json.loads((out / "refine.json").read_text())
     assert doc["kept"] == summary["kept"] and doc["settings"]["ranges"] == 2 and len(doc["ranges"]) == 8
@@ -63,7 +66,7 @@ def test_refined_dataset_is_readable_and_traceable(source, tmp_path):
 
 
 def test_same_input_and_seed_same_kept(source, tmp_path):
-    bov = BoVConfig(ranges=3, words=4, max_features=40)
+    bov = BoVConfig(ranges=3, words=4, sift=SIFT)
     config = RefineConfig(dataset=source, out=tmp_path / "a", bov=bov, cache_dir=tmp_path / "cache", seed=3)
     a = refine_dataset(config)
     b = refine_dataset(replace(config, out=tmp_path / "b"))

@@ -190,7 +190,7 @@ def test_evaluate_error_midway_leaves_no_partial_output(tmp_path, monkeypatch):
     out = tmp_path / "ev"
 
     def args(folder: Path) -> list[str]:
-        return ["evaluate", str(mesh), "--gt", str(mesh), "--out", str(folder), "--n-points", "2000"]
+        return ["evaluate", str(mesh), "--gt", str(mesh), "--out", str(folder), "--metric-points", "2000"]
 
     assert main(args(out)) == 0
     before = snapshot(out)

@@ -15,7 +15,7 @@ from nbv.cli import main
 def scan(tmp_path_factory):
     """A 4-view circle scan of test_building at 64x48, 1 spp, made with `nbv scan`."""
     out = tmp_path_factory.mktemp("export_cli") / "ds"
-    assert main(["scan", "test_building", "--plan", "circle", "--views", "4", "--width", "64",
+    assert main(["scan", "test_building", "circle", "--views", "4", "--width", "64",
                  "--height", "48", "--spp", "1", "--out", str(out)]) == 0
     return out
 

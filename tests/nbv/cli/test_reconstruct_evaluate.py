@@ -44,11 +44,11 @@ def test_reconstruct_then_evaluate(dataset, tmp_path, capsys) -> None:
     assert len(mesh.faces) > 1000
     assert len(trimesh.load(recon / "points.ply").vertices) > 1000
     summary = json.loads((recon / "reconstruction.json").read_text())
-    assert summary["views"] == 37 and summary["config"]["voxel_size_m"] == 0.004
+    assert summary["views"] == 37 and summary["config"]["recon"]["voxel_size_m"] == 0.004
 
     ev = tmp_path / "eval"
     assert main(["evaluate", str(recon / "mesh.ply"), "--gt", "test_building", "--reference",
-                 str(recon / "mesh.ply"), "--out", str(ev), "--n-points", "50000"]) == 0
+                 str(recon / "mesh.ply"), "--out", str(ev), "--metric-points", "50000"]) == 0
     doc = json.loads((ev / "metrics.json").read_text())
     assert set(doc["gt"]) == KEYS and set(doc["reference"]) == KEYS
     assert doc["reference"]["chamfer_cm"] == 0.0 and doc["reference"]["coverage"] == 1.0
@@ -62,9 +62,9 @@ def test_reconstruct_then_evaluate(dataset, tmp_path, capsys) -> None:
     gt_file = tmp_path / "gt.ply"
     load_scene("test_building").target_mesh().export(gt_file)
     assert main(["evaluate", str(recon / "mesh.ply"), "--gt", str(gt_file), "--out", str(tmp_path / "ev2"),
-                 "--n-points", "50000", "--threshold-cm", "0.5"]) == 0
+                 "--metric-points", "50000", "--threshold-cm", "0.5"]) == 0
     doc2 = json.loads((tmp_path / "ev2" / "metrics.json").read_text())
-    assert set(doc2) == {"gt", "run"} and doc2["gt"]["threshold_cm"] == 0.5
+    assert set(doc2) == {"gt", "run", "commit", "command", "config"} and doc2["gt"]["threshold_cm"] == 0.5
     assert doc2["gt"]["chamfer_cm"] == pytest.approx(doc["gt"]["chamfer_cm"], rel=1e-6)
 
     # Nothing written is lost: a second run into the same folders refuses without --overwrite.
@@ -102,7 +102,7 @@ def test_a_y_up_ground_truth_gives_the_metrics_of_its_z_up_twin(tmp_path, capsys
     for name, extra in (("zup", []), ("yup", ["--up-axis", "y"]), ("yup_as_z", [])):
         gt = tmp_path / f"{name.removesuffix('_as_z')}.obj"
         assert main(["evaluate", str(tmp_path / "mesh.ply"), "--gt", str(gt), *extra, "--out",
-                     str(tmp_path / name), "--n-points", "20000", "--seed", "4"]) == 0
+                     str(tmp_path / name), "--metric-points", "20000", "--seed", "4"]) == 0
         docs[name] = json.loads((tmp_path / name / "metrics.json").read_text())
     assert docs["yup"]["gt"] == docs["zup"]["gt"] and docs["zup"]["gt"]["chamfer_cm"] > 0.1
     assert docs["yup"]["run"]["up_axis"] == "y" and docs["yup"]["run"]["metrics"]["seed"] == 4

@@ -4,6 +4,7 @@ import json
 
 from nbv.bov.config import BoVConfig
 from nbv.cli import main
+from nbv.features.config import FeatureConfig
 from nbv.rl.builders import make_loss_module, make_optimizers, make_replay_buffer, make_sac_agent
 from nbv.rl.config import EnvConfig, LoggerConfig, OptimConfig, TrainConfig
 from nbv.rl.train import write_checkpoint
@@ -15,7 +16,8 @@ from scenes.spec import SceneSet
 def untrained_policy(run) -> str:
     """A `policy.pt` of untrained networks on a tiny env (the demo's online half only needs its shape)."""
     env = EnvConfig(scenes=SceneSet(scene=("test_building",)), camera=UAVCamera(64, 48),
-                    render=RenderSettings(spp=1), bov=BoVConfig(ranges=8, features="opencv"), obs_size=32,
+                    render=RenderSettings(spp=1),
+                    bov=BoVConfig(ranges=8, sift=FeatureConfig(backend="opencv")), obs_size=32,
                     max_steps=3)
     config = TrainConfig(env=env, logger=LoggerConfig(out=run))
     actor, critic = make_sac_agent(env, config.network)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from nbv.bov.config import BoVConfig
+from nbv.features.config import FeatureConfig
 from nbv.planning.infogain import InfoGainPlanner, target_grid
 from nbv.planning.planners import make_planner
 from nbv.recon.config import OccupancyConfig
@@ -17,7 +18,8 @@ from scenes import load_scene
 from scenes.spec import SceneSet
 
 CONFIG = EnvConfig(scenes=SceneSet(scene=("test_building",)), camera=UAVCamera(64, 48),
-                   render=RenderSettings(spp=1), bov=BoVConfig(ranges=8, features="opencv"), obs_size=32)
+                   render=RenderSettings(spp=1),
+                   bov=BoVConfig(ranges=8, sift=FeatureConfig(backend="opencv")), obs_size=32)
 
 
 def test_infogain_moves_to_the_candidate_of_highest_gain(monkeypatch):

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from nbv.bov.config import BoVConfig
+from nbv.features.config import FeatureConfig
 from nbv.planning.oracle import (
     POOL,
     CoverageOraclePlanner,
@@ -25,7 +26,8 @@ from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes.spec import SceneSet
 
 CONFIG = EnvConfig(scenes=SceneSet(scene=("test_building",)), camera=UAVCamera(64, 48),
-                   render=RenderSettings(spp=1), bov=BoVConfig(ranges=8, features="opencv"), obs_size=32)
+                   render=RenderSettings(spp=1),
+                   bov=BoVConfig(ranges=8, sift=FeatureConfig(backend="opencv")), obs_size=32)
 
 
 def coverage(views: list[Viewpoint], seed: int) -> float:

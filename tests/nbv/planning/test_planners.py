@@ -10,6 +10,7 @@ import pytest
 import torch
 
 from nbv.bov.config import BoVConfig
+from nbv.features.config import FeatureConfig
 from nbv.planning.planners import (
     SHIPPED_POLICY,
     CirclePlanner,
@@ -36,7 +37,7 @@ TEST_BUILDING = SceneSet(scene=("test_building",))
 
 def tiny_env(seed: int = 0, **kwargs) -> NBVEnv:
     settings = dict(scenes=TEST_BUILDING, camera=UAVCamera(64, 48), render=RenderSettings(spp=1),
-                    bov=BoVConfig(ranges=8, features="opencv"), obs_size=32, max_steps=4)
+                    bov=BoVConfig(ranges=8, sift=FeatureConfig(backend="opencv")), obs_size=32, max_steps=4)
     config = EnvConfig(**{**settings, **kwargs})
     return NBVEnv(config, seed=seed)
 

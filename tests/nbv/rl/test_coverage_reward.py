@@ -11,6 +11,7 @@ import torch
 from tensordict import TensorDict
 
 from nbv.bov.config import BoVConfig
+from nbv.features.config import FeatureConfig
 from nbv.recon.visibility import scene_visibility
 from nbv.rl.config import EnvConfig, LatticeConfig, ValidationConfig
 from nbv.rl.env import NBVEnv
@@ -27,7 +28,8 @@ ACTIONS = ([0.0, 0.5, 0.3], [0.0, 0.0, 0.0], [0.4, -0.7, -0.2])
 
 def config(**kwargs) -> EnvConfig:
     settings = dict(scenes=SceneSet(scene=("test_building",)), camera=UAVCamera(64, 48),
-                    render=RenderSettings(spp=1), bov=BoVConfig(ranges=4, words=5, features="opencv"),
+                    render=RenderSettings(spp=1),
+                    bov=BoVConfig(ranges=4, words=5, sift=FeatureConfig(backend="opencv")),
                     obs_size=16, max_steps=5, action_mode="relative")
     return EnvConfig(**{**settings, **kwargs})
 

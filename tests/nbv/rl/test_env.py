@@ -27,8 +27,8 @@ from scenes.spec import SceneSet
 def tiny_config(width: int = 64, height: int = 48, match_cosine: float = 0.8, **kwargs) -> EnvConfig:
     """A tiny, fast env: 64x48 renders, 32x32 frames, 1 spp, OpenCV SIFT."""
     settings = dict(scenes=SceneSet(scene=("test_building",)), camera=UAVCamera(width, height),
-                    render=RenderSettings(spp=1), bov=BoVConfig(ranges=8, features="opencv",
-                                                                match_cosine=match_cosine),
+                    render=RenderSettings(spp=1), bov=BoVConfig(ranges=8, match_cosine=match_cosine,
+                                                                sift=FeatureConfig(backend="opencv")),
                     obs_size=32, max_steps=3)
     return EnvConfig(**{**settings, **kwargs})
 

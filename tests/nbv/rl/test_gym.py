@@ -7,6 +7,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 from nbv.bov.config import BoVConfig
+from nbv.features.config import FeatureConfig
 from nbv.rl.config import EnvConfig
 from nbv.rl.gym import NBVGymEnv
 from render.camera import UAVCamera
@@ -17,7 +18,8 @@ from scenes.spec import SceneSet
 def tiny_config(**kwargs) -> EnvConfig:
     """64x48 renders at 1 spp, 16x16 frames, OpenCV SIFT, 3-step episodes."""
     settings = dict(scenes=SceneSet(scene=("test_building",)), camera=UAVCamera(64, 48),
-                    render=RenderSettings(spp=1), bov=BoVConfig(ranges=8, features="opencv"),
+                    render=RenderSettings(spp=1),
+                    bov=BoVConfig(ranges=8, sift=FeatureConfig(backend="opencv")),
                     obs_size=16, max_steps=3)
     return EnvConfig(**{**settings, **kwargs})
 

@@ -10,6 +10,7 @@ import torch
 from tensordict import TensorDict
 
 from nbv.bov.config import BoVConfig
+from nbv.features.config import FeatureConfig
 from nbv.features.sift import extract_features
 from nbv.rl.config import EnvConfig, LatticeConfig
 from nbv.rl.env import NBVEnv, gray_frame
@@ -63,7 +64,7 @@ def test_every_viewpoint_lies_within_the_snapping_error_of_its_node():
 def test_env_on_a_lattice_sees_cached_node_renders_and_reuses_the_cache(monkeypatch):
     grid = LatticeConfig(enabled=True, lattice_radii=2, lattice_azimuths=4, lattice_elevations=2)
     cfg = config(grid, camera=UAVCamera(64, 48), render=RenderSettings(spp=1), obs_size=16,
-                 bov=BoVConfig(ranges=4, words=5, features="opencv"), action_mode="orbit")
+                 bov=BoVConfig(ranges=4, words=5, sift=FeatureConfig(backend="opencv")), action_mode="orbit")
     env = NBVEnv(cfg, seed=3)
     td = env.reset()
     start = env.viewpoint
@@ -90,8 +91,8 @@ def test_relative_steps_on_a_lattice_accumulate_from_the_exact_viewpoint(tmp_pat
     monkeypatch.setenv("NBV_CACHE_DIR", str(tmp_path))
     grid = LatticeConfig(enabled=True, lattice_radii=3, lattice_azimuths=4, lattice_elevations=2)
     cfg = config(grid, camera=UAVCamera(64, 48), render=RenderSettings(spp=1), obs_size=16,
-                 bov=BoVConfig(ranges=4, words=5, features="opencv"), action_mode="relative",
-                 relative_step=0.125)
+                 bov=BoVConfig(ranges=4, words=5, sift=FeatureConfig(backend="opencv")),
+                 action_mode="relative", relative_step=0.125)
     env = NBVEnv(cfg, seed=1)
     env.reset()
     start = env.viewpoint
@@ -129,7 +130,7 @@ def test_lattice_units_on_local_workers_cache_what_the_env_renders(tmp_path, mon
 
     grid = LatticeConfig(enabled=True, lattice_radii=1, lattice_azimuths=4, lattice_elevations=2)
     cfg = config(grid, camera=UAVCamera(64, 48), render=RenderSettings(spp=1), obs_size=32,
-                 bov=BoVConfig(ranges=8, features="opencv"))
+                 bov=BoVConfig(ranges=8, sift=FeatureConfig(backend="opencv")))
     monkeypatch.setenv("NBV_CACHE_DIR", str(tmp_path / "here"))
     env = NBVEnv(cfg, seed=3)
     env.reset()  # renders the lattice in this process, into this cache

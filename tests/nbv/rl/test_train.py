@@ -14,6 +14,7 @@ from tensordict import TensorDict
 
 from nbv.bov.config import BoVConfig
 from nbv.cli import main
+from nbv.features.config import FeatureConfig
 from nbv.rl.builders import make_loss_module, make_optimizers, make_sac_agent
 from nbv.rl.checkpoint import CheckpointError, load_checkpoint, save_checkpoint
 from nbv.rl.config import CollectorConfig, EnvConfig, LoggerConfig, OptimConfig, TrainConfig
@@ -29,7 +30,8 @@ TINY_ENV = ["--scene", "test_building", "--width", "64", "--height", "48", "--sp
 
 def tiny(out, frames: int, **collector) -> TrainConfig:
     env = EnvConfig(scenes=SceneSet(scene=("test_building",)), camera=UAVCamera(64, 48),
-                    render=RenderSettings(spp=1), bov=BoVConfig(ranges=8, features="opencv"), obs_size=32,
+                    render=RenderSettings(spp=1),
+                    bov=BoVConfig(ranges=8, sift=FeatureConfig(backend="opencv")), obs_size=32,
                     max_steps=3)
     settings = {"frames": frames, "frames_per_batch": 2, "init_random_frames": 2, "seed": 7, **collector}
     return TrainConfig(env=env, collector=CollectorConfig(**settings),

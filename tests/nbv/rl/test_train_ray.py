@@ -10,6 +10,7 @@ import torch
 
 from nbv.bov.config import BoVConfig
 from nbv.cli import main
+from nbv.features.config import FeatureConfig
 from nbv.rl.builders import make_ray_collector, make_sac_agent
 from nbv.rl.checkpoint import load_checkpoint
 from nbv.rl.config import CollectorConfig, EnvConfig, NetworkConfig
@@ -39,7 +40,8 @@ def test_a_ray_collected_run_checkpoints_and_resumes(tmp_path, monkeypatch):
 def test_the_ray_collectors_act_with_the_learners_weights(monkeypatch):
     monkeypatch.delenv("RAY_ADDRESS", raising=False)
     env = EnvConfig(scenes=SceneSet(scene=("test_building",)), camera=UAVCamera(64, 48),
-                    render=RenderSettings(spp=1), bov=BoVConfig(ranges=8, features="opencv"), obs_size=32,
+                    render=RenderSettings(spp=1),
+                    bov=BoVConfig(ranges=8, sift=FeatureConfig(backend="opencv")), obs_size=32,
                     max_steps=3)
     actor, _ = make_sac_agent(env, NetworkConfig())
     config = CollectorConfig(frames=4, frames_per_batch=2, init_random_frames=0, collector="ray")

@@ -9,9 +9,10 @@ from typing import Any
 
 from tqdm import tqdm
 
+from common.io import check_output_folder
 from common.provenance import run_record
 from render.camera import UAVCamera
-from render.dataset import DatasetWriter, check_output_folder
+from render.dataset import DatasetWriter
 from render.renderer import MitsubaRenderer
 from render.scan import ScanConfig, plan_record
 from render.settings import RenderSettings

@@ -21,14 +21,14 @@ import numpy as np
 import torch
 from tyro.conf import Positional, arg
 
-from common.io import check_separate
+from common.io import check_output_folder, check_separate
 from common.provenance import config_record, run_record
 from common.threads import set_torch_threads
 from nbv.bov.bag import BagOfViews
 from nbv.bov.config import BoVConfig, BoVRule
 from nbv.features.cache import dataset_features
 from nbv.features.sift import DESCRIPTOR_DIM, Features
-from render.dataset import ViewDataset, check_output_folder, read_dataset, write_subset
+from render.dataset import ViewDataset, read_dataset, write_subset
 from render.viewpoint import c2w_to_viewpoint
 
 Progress = Callable[[int], None]

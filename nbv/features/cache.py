@@ -20,7 +20,8 @@ import cv2
 import kornia
 import torch
 
-from common.io import atomic_path, cache_dir
+from common.io import atomic_path
+from common.io import cache_dir as cache_root
 from nbv.features.sift import DESCRIPTOR_DIM, FeatureConfig, Features, extract_features
 from render.dataset import ViewDataset
 from render.dataset_read import image_bytes
@@ -30,7 +31,7 @@ CACHE_VERSION = 1
 
 def default_cache_dir() -> Path:
     """`features/` under the project's cache root (`$NBV_CACHE_DIR`, else `~/.cache/nbv`)."""
-    return cache_dir() / "features"
+    return cache_root() / "features"
 
 
 def dataset_digest(dataset: ViewDataset) -> str:

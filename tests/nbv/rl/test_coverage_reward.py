@@ -6,7 +6,7 @@ true mesh (across a restore: test_env's snapshot test)."""
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from dataclasses import fields, replace
 
 import pytest
 import torch
@@ -119,7 +119,9 @@ def test_the_run_config_holds_the_term_in_its_reward_group_not_in_the_env():
 
     record = config_record(parse_train(["--coverage-reward", "30", "--out", "run"]))
     assert record["reward"] == {"coverage": 30.0} and "coverage_reward" not in record["env"]
-    assert not any("coverage" in field for field in EnvConfig.__dataclass_fields__)
+    assert not any("coverage" in field.name for field in fields(EnvConfig))
+    with pytest.raises(ValueError, match="training-only term, not an env setting"):
+        EnvConfig(scenes=SceneSet(scene=("test_building",)), coverage_reward=30.0)
 
 
 @pytest.mark.parametrize("weight", [-1.0, math.inf, math.nan])

@@ -5,7 +5,8 @@ training buildings (`TRAIN_SCENES`) and is scored on validation buildings that n
 (`VALIDATION_SCENES`: training-split `random:SEED` buildings; the test buildings alpine_chalet,
 imperial_temple and random:SEED with SEED % 5 == 0 are never touched here). The score is the policy's
 mode over `--episodes` start views per building, rendered at exact viewpoints, scored by the
-visible-surface coverage of the true mesh (`nbv.recon.visibility`).
+visible-surface coverage of the true mesh (`nbv.rl.validate.validation_score`, the library's
+model-selection score). This script keeps the rounds' candidates and runs them.
 
     python scripts/select_defaults.py train --round 2 --runs runs/selection --frames 6000 --jobs 3
     python scripts/select_defaults.py score --runs runs/selection --out paper_results/selection
@@ -23,7 +24,6 @@ import subprocess
 import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -31,14 +31,10 @@ from tqdm import tqdm
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import git_commit
-from nbv.planning.planners import Planner, PolicyPlanner, make_planner
-from nbv.recon.visibility import scene_visibility
-from nbv.rl.config import EnvConfig, LatticeConfig
-from nbv.rl.env import NBVEnv
+from nbv.planning.planners import PolicyPlanner, make_planner
 from nbv.rl.presets import TRAIN_SCENES, VALIDATION_SCENES
+from nbv.rl.validate import validation_score
 from nbv.viz.figures import plot_seed_scores
-from render.viewpoint import viewpoint_to_c2w
-from scenes.spec import SceneSet
 
 BASE = ("--preset", "paper", "--width", "160", "--height", "120", "--spp", "4", "--feature-backend", "opencv",
         "--lattice", "--relative-step", "0.125", "--threads", "1", "--no-progress")
@@ -123,22 +119,6 @@ def train_all(args: argparse.Namespace) -> None:
             print(f"{name} seed {seed}: {future.result():.0f} s", flush=True)
 
 
-def episode_coverage(planner: Planner, env_config: EnvConfig, scene: str, views: int, seed: int) -> float:
-    """Visible-surface coverage of the true mesh by the planner's `views` viewpoints (exact renders)."""
-    config = replace(env_config, scenes=SceneSet(scene=(scene,)), lattice=LatticeConfig())
-    env = NBVEnv(config, seed=seed)
-    chosen = planner.plan(env, views)
-    loaded = config.scenes.specs()[0].load()
-    poses = [viewpoint_to_c2w(v, loaded.center()) for v in chosen]
-    return scene_visibility(loaded, config.camera, seed=seed).coverage(poses)
-
-
-def validation_score(planner: Planner, env_config: EnvConfig, views: int, episodes: int) -> float:
-    """Mean visible-surface coverage (%) over `VALIDATION_SCENES` x `episodes` start views."""
-    return 100.0 * float(np.mean([episode_coverage(planner, env_config, scene, views, seed)
-                                  for scene in VALIDATION_SCENES for seed in range(episodes)]))
-
-
 def score_all(args: argparse.Namespace) -> None:
     """Score every finished run and the random and circle baselines; write selection.{json,md,png}."""
     runs = sorted(p.parent for p in args.runs.glob("*-seed*/policy.pt"))
@@ -154,11 +134,11 @@ def score_all(args: argparse.Namespace) -> None:
         if saved.is_file() and json.loads(saved.read_text())["key"] == key:
             score = json.loads(saved.read_text())["score"]
         else:
-            score = validation_score(planner, env_config, args.views, args.episodes)
+            score = validation_score(planner, env_config, VALIDATION_SCENES, args.views, args.episodes)
             write_json(saved, {"key": key, "score": score})
         scores.setdefault(name, {})[int(seed)] = score
-    baselines = {name: validation_score(make_planner(name, seed=0), env_config, args.views, args.episodes)
-                 for name in ("random", "circle")}
+    baselines = {name: validation_score(make_planner(name, seed=0), env_config, VALIDATION_SCENES, args.views,
+                                        args.episodes) for name in ("random", "circle")}
     seeds = sorted({seed for by_seed in scores.values() for seed in by_seed})
     rows = [[name, len(by_seed), *(f"{by_seed[s]:.1f}" if s in by_seed else "-" for s in seeds),
              f"{np.mean(list(by_seed.values())):.1f} ± {np.std(list(by_seed.values())):.1f}"]

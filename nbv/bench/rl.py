@@ -15,12 +15,14 @@ import numpy as np
 import torch
 from tensordict import TensorDict
 
+from common.threads import set_torch_threads
 from nbv.bench import BenchResult, temporary_cache
 from nbv.bench.threads import planning_step_ms
-from nbv.rl.builders import make_environment, make_loss_module, make_sac_agent
+from nbv.rl.builders import make_environment, make_loss_module, make_optimizers, make_sac_agent
 from nbv.rl.config import EnvConfig, LatticeConfig, NetworkConfig, OptimConfig
 from nbv.rl.env import NBVEnv
 from nbv.rl.lattice import build_lattice
+from nbv.rl.train import sac_update
 from render.camera import UAVCamera
 from render.renderer import MitsubaRenderer
 from render.viewpoint import Viewpoint
@@ -43,10 +45,11 @@ def env_steps_per_s(config: EnvConfig, workers: int, steps: int) -> float:
 
 
 def sac_updates_per_s(config: EnvConfig, updates: int, batch: int = 8) -> float:
-    """SAC gradient steps per second (twin critics, batch 8, Table 1) on random transitions."""
+    """SAC gradient steps per second (twin critics, batch 8, Table 1) on random transitions: the training
+    loop's own step (`nbv.rl.train.sac_update`, `make_optimizers`)."""
     actor, critic = make_sac_agent(config, NetworkConfig())
     loss, _ = make_loss_module(actor, critic, OptimConfig())
-    optim = torch.optim.Adam(loss.parameters(), lr=5e-4)
+    optim_actor, optim_critic = make_optimizers(loss, OptimConfig())
     tau, side = config.history, config.obs_size
 
     def state() -> dict:
@@ -61,10 +64,7 @@ def sac_updates_per_s(config: EnvConfig, updates: int, batch: int = 8) -> float:
     for i in range(updates + 1):
         if i == 1:  # the first step (lazy initialisation) is not timed
             start = time.perf_counter()
-        out = loss(sample.clone())
-        optim.zero_grad()
-        (out["loss_actor"] + out["loss_qvalue"]).backward()
-        optim.step()
+        sac_update(loss, optim_actor, optim_critic, sample.clone())
     return updates / (time.perf_counter() - start)
 
 
@@ -110,7 +110,7 @@ def lattice_vs_render(config: EnvConfig, steps: int) -> list[BenchResult]:
 
 def run(quick: bool) -> list[BenchResult]:
     """Env steps/s (1 and 2 workers, 320x240), SAC updates/s, planning ms/step (1 torch thread)."""
-    torch.set_num_threads(1)
+    set_torch_threads(1)
     config = EnvConfig(scenes=SceneSet(scene=(DEFAULT_SCENE,)))
     steps = 4 if quick else 20
     results = []

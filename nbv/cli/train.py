@@ -8,9 +8,9 @@ from dataclasses import replace
 import tyro
 
 from nbv.cli.parse import parse
+from nbv.rl.command import train_command
 from nbv.rl.config import TrainConfig
 from nbv.rl.presets import PRESETS
-from nbv.rl.train import train
 from scenes.spec import SceneSet
 
 
@@ -44,5 +44,5 @@ def parse_train(args: Sequence[str], prog: str = "nbv train") -> TrainConfig:
 
 def main(args: Sequence[str], prog: str) -> int:
     """Parse the config, train (or resume) into the run folder, print the checkpoint path."""
-    print(train(parse_train(args, prog)))
+    print(train_command(parse_train(args, prog)))
     return 0

@@ -25,6 +25,7 @@ from nbv.rl.config import (
     NetworkConfig,
     OptimConfig,
     ReplayBufferConfig,
+    RewardConfig,
 )
 from nbv.rl.env import NBVEnv
 
@@ -34,8 +35,10 @@ RAY_COLLECTOR_MEMORY = 1024**3
 """Memory a Ray collector actor reserves: one renderer, one env, a policy copy."""
 
 
-def make_environment(config: EnvConfig, envs: int, seed: int) -> EnvBase:
-    """The training env: an in-process `NBVEnv` or a `ParallelEnv` of spawned workers, returns summed.
+def make_environment(config: EnvConfig, envs: int, seed: int,
+                     reward_terms: RewardConfig = RewardConfig()) -> EnvBase:
+    """The training env: an in-process `NBVEnv` or a `ParallelEnv` of spawned workers, returns summed,
+    with the training-only `reward_terms` (`TrainConfig.reward`; none by default).
 
     Worker i is seeded `seed + i` and starts its scene cycle at scene i. The scenes are
     loaded once here first, so a bad scene name fails in this process with a clear message
@@ -44,9 +47,9 @@ def make_environment(config: EnvConfig, envs: int, seed: int) -> EnvBase:
     for spec in config.scenes.specs():
         spec.load()
     if envs == 1:
-        base: EnvBase = NBVEnv(config, 0, seed)
+        base: EnvBase = NBVEnv(config, 0, seed, reward_terms)
     else:
-        base = ParallelEnv(envs, [partial(NBVEnv, config, i, seed + i) for i in range(envs)],
+        base = ParallelEnv(envs, [partial(NBVEnv, config, i, seed + i, reward_terms) for i in range(envs)],
                            mp_start_method="spawn", serial_for_single=True)
     return TransformedEnv(base, RewardSum())
 
@@ -98,15 +101,16 @@ def make_collector(env: EnvBase, actor: ProbabilisticActor, config: CollectorCon
                      track_traj_ids=False, auto_register_policy_transforms=False)
 
 
-def make_worker_env(config: EnvConfig, index: int, seed: int) -> EnvBase:
+def make_worker_env(config: EnvConfig, index: int, seed: int,
+                    reward_terms: RewardConfig = RewardConfig()) -> EnvBase:
     """A Ray collector's env, built inside its actor: Dr.Jit and torch capped to the actor's one core
     (`nbv.fanout.worker`), the Mitsuba variant chosen there, returns summed as `make_environment`'s."""
     cap_threads(RAY_COLLECTOR_CPUS)
-    return TransformedEnv(NBVEnv(config, index, seed), RewardSum())
+    return TransformedEnv(NBVEnv(config, index, seed, reward_terms), RewardSum())
 
 
 def make_ray_collector(env: EnvConfig, actor: ProbabilisticActor, config: CollectorConfig, seed: int,
-                       frames_done: int = 0) -> RayCollector:
+                       frames_done: int = 0, reward_terms: RewardConfig = RewardConfig()) -> RayCollector:
     """`config.collectors` Ray actors of one env each (collector i seeded `seed + i`, starting at scene i),
     collecting in step: each batch stacks theirs, and they get the actor's weights before every batch.
 
@@ -118,7 +122,7 @@ def make_ray_collector(env: EnvConfig, actor: ProbabilisticActor, config: Collec
     ray_init = ({"address": os.environ["RAY_ADDRESS"]} if os.environ.get("RAY_ADDRESS") else
                 {"address": "local", "num_cpus": config.collectors, "include_dashboard": False})
     collector = RayCollector(
-        [partial(make_worker_env, env, i, seed + i) for i in range(config.collectors)], actor,
+        [partial(make_worker_env, env, i, seed + i, reward_terms) for i in range(config.collectors)], actor,
         frames_per_batch=config.frames_per_batch, total_frames=config.frames - frames_done,
         init_random_frames=_random_frames(config, frames_done), sync=True, update_after_each_batch=True,
         ray_init_config={**ray_init, "log_to_driver": False},

@@ -24,6 +24,7 @@ import numpy as np
 import torch
 
 from common.io import atomic_path
+from nbv.rl.config import upgrade_record
 
 FORMAT = "nbv-sac-checkpoint"
 VERSION = 1
@@ -126,7 +127,9 @@ def load_policy(path: str | Path) -> tuple[dict[str, Any], dict[str, torch.Tenso
 
 
 def checkpoint_config(state: dict[str, Any], path: str | Path = "checkpoint") -> dict[str, Any]:
-    """The run config stored in a checkpoint, as a nested dict (CheckpointError naming `path` if not one)."""
+    """The run config stored in a checkpoint, as a nested dict in today's layout (`upgrade_record`: a
+    record from before a key moved group reads as if written now); CheckpointError naming `path` if not
+    one."""
     try:
         config = json.loads(state["config"])
     except (TypeError, ValueError, RecursionError) as err:
@@ -134,7 +137,7 @@ def checkpoint_config(state: dict[str, Any], path: str | Path = "checkpoint") ->
     if not isinstance(config, dict):
         raise CheckpointError(f"checkpoint {path}: its config must be a JSON object, "
                               f"got {type(config).__name__}")
-    return config
+    return upgrade_record(config)
 
 
 def check_compatible(path: str | Path, saved: dict[str, Any], current: dict[str, Any],

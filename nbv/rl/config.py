@@ -6,17 +6,20 @@ set, camera, render settings and Bag of Views) and one group per training
 concern. Defaults follow the paper's Table 1 (batch 8, learning rate 5e-4,
 fixed temperature alpha 0.2, target networks soft-updated by 0.01 every 20
 gradient steps, replay buffer of 1e6 transitions, discount 0.99).
+Training-only reward terms, which read the true mesh, are `TrainConfig`'s
+`reward` group, not the env's: an env rebuilt from a trained run's
+`EnvConfig` (planning, validation, scoring) cannot inherit them.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import InitVar, dataclass
 from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
-from tyro.conf import arg
+from tyro.conf import Suppress, arg
 
 from common.threads import WORKER_THREADS
 from nbv.bov.config import BoVConfig
@@ -86,12 +89,15 @@ class EnvConfig:
     relative_step: float = 0.25
     """Relative and orbit modes: the largest step per action, as a fraction of each range (azimuth: of
     2 pi)."""
-    coverage_reward: float = 0.0
-    """Weight W of a geometric reward term, beyond the paper: W x the share of the target's surface
-    samples that the new view is the first of its episode to see (ground truth, so training only).
-    0: the Bag of Views reward alone (the paper)."""
+    coverage_reward: InitVar[Annotated[float, Suppress]] = 0.0
+    """Not a setting (no flag, not recorded): kept, 0 only, while `nbv/planning/plan.py` still passes
+    `coverage_reward=0.0`; delete once it calls `nbv.rl.validate.evaluation_env_config`. The coverage
+    term is `TrainConfig.reward`'s."""
 
-    def __post_init__(self) -> None:
+    def __post_init__(self, coverage_reward: float = 0.0) -> None:
+        if coverage_reward:
+            raise ValueError("the coverage reward is a training-only term, not an env setting: "
+                             "TrainConfig.reward.coverage (--coverage-reward) gives it to the training env")
         if not 0 < self.radius_min <= self.radius_max:
             raise ValueError(f"need 0 < radius_min <= radius_max, got {self.radius_min}, {self.radius_max}")
         check_camera_distance("radius_min", self.radius_min, self.camera)
@@ -107,8 +113,6 @@ class EnvConfig:
                              f"{self.max_steps + 1}], got {self.episode_views}")
         if not 0 < self.relative_step <= 1:
             raise ValueError(f"relative_step must lie in (0, 1], got {self.relative_step}")
-        if not 0 <= self.coverage_reward < math.inf:
-            raise ValueError(f"coverage_reward must be finite and >= 0, got {self.coverage_reward}")
 
     @property
     def low(self) -> np.ndarray:
@@ -262,23 +266,46 @@ class ValidationConfig:
     """Views per validation episode, the start view included."""
     validation_points: int = 20_000
     """True-surface samples of the coverage score per building."""
-    members: int = 1
-    """Independent training runs of the command (seeds seed*members .. seed*members + members-1, in
-    RUN/memberK/, side by side where --workers says); `policy.pt` is the best-validated actor of them all
-    (`nbv.rl.members`). 1: one run, in RUN itself."""
 
     def __post_init__(self) -> None:
-        for name in ("validation_episodes", "validation_views", "validation_points", "members"):
+        for name in ("validation_episodes", "validation_views", "validation_points"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
-        if self.members > 1 and not self.validation_scenes:
-            raise ValueError(f"members ({self.members}) are compared on validation buildings: give "
-                             "--validation-scenes")
 
     @property
     def enabled(self) -> bool:
         """Whether checkpoints are scored on validation buildings."""
         return bool(self.validation_scenes)
+
+
+@dataclass(frozen=True)
+class RewardConfig:
+    """Training-only reward terms, beyond the paper, added to the Bag of Views reward. They read the true
+    mesh, so only the training env gets them (`nbv.rl.builders.make_environment`); an `NBVEnv` built
+    from an `EnvConfig` alone (planning, validation, scoring) has none."""
+
+    coverage: Annotated[float, arg(name="coverage-reward")] = 0.0
+    """Weight W of a geometric reward term: W x the share of the target's surface samples that the new
+    view is the first of its episode to see (ground truth, so training only). 0: the Bag of Views reward
+    alone (the paper)."""
+
+    def __post_init__(self) -> None:
+        if not 0 <= self.coverage < math.inf:
+            raise ValueError(f"coverage_reward must be finite and >= 0, got {self.coverage}")
+
+
+@dataclass(frozen=True)
+class MembersConfig:
+    """Several training seeds per command (`nbv.rl.members`)."""
+
+    count: Annotated[int, arg(name="members")] = 1
+    """Independent training runs of the command (seeds seed*members .. seed*members + members-1, in
+    RUN/memberK/, side by side where --workers says); `policy.pt` is the best-validated actor of them all
+    (`nbv.rl.members`). 1: one run, in RUN itself."""
+
+    def __post_init__(self) -> None:
+        if self.count < 1:
+            raise ValueError(f"members must be >= 1, got {self.count}")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -301,6 +328,8 @@ class TrainConfig:
 
     env: EnvConfig
     """The environment."""
+    reward: RewardConfig = RewardConfig()
+    """Training-only reward terms (the training env's alone)."""
     collector: CollectorConfig = CollectorConfig()
     """Data collection."""
     replay_buffer: ReplayBufferConfig = ReplayBufferConfig()
@@ -313,6 +342,33 @@ class TrainConfig:
     """Logs and checkpoints."""
     validation: ValidationConfig = ValidationConfig()
     """Checkpoint selection on validation buildings (off by default; on in the `default` preset)."""
+    members: MembersConfig = MembersConfig()
+    """Training seeds of the command, the best-validated kept (one by default; three in the `default`
+    preset)."""
     executor: ExecutorConfig = ExecutorConfig()
     """Where the scenes' view lattices are rendered before training (--lattice), and where the members
     train (--members): this process, local workers or Ray."""
+
+    def __post_init__(self) -> None:
+        if self.members.count > 1 and not self.validation.enabled:
+            raise ValueError(f"members ({self.members.count}) are compared on validation buildings: give "
+                             "--validation-scenes")
+
+
+MOVED_KEYS = {("env", "coverage_reward"): ("reward", "coverage"),
+              ("validation", "members"): ("members", "count")}
+"""Run-record keys that moved group since records were first written: (old group, key) -> (new group, key).
+The shipped policy and paper_results/online/policies record the old layout."""
+
+
+def upgrade_record(record: dict) -> dict:
+    """A `TrainConfig` record (a run's config.json, a checkpoint's or policy file's config) in today's
+    layout: each of `MOVED_KEYS` moved to its new group (a copy; today's records come back equal)."""
+    record = {key: dict(value) if isinstance(value, dict) else value for key, value in record.items()}
+    for (old_group, old_key), (new_group, new_key) in MOVED_KEYS.items():
+        group = record.get(old_group)
+        if isinstance(group, dict) and old_key in group:
+            value = group.pop(old_key)
+            if isinstance(record.setdefault(new_group, {}), dict):
+                record[new_group].setdefault(new_key, value)
+    return record

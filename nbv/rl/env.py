@@ -23,8 +23,9 @@ docs/bov.md), from the config's `bov` (its match cosine included; with
 `elevation_bands` E > 1 each azimuth range is split into E bands over the
 allowed elevations, beyond the paper). The BoV is
 emptied at each reset and learns the episode's first view without reward.
-With `coverage_reward` W > 0 (beyond the paper, training only: it reads the
-true mesh) the reward adds W x the share of the target's surface samples
+With training-only `reward_terms` (`RewardConfig`, given by the training builders
+alone) of coverage weight W > 0 (beyond the paper: it reads the true mesh) the
+reward adds W x the share of the target's surface samples
 (`nbv.recon.visibility`) that the new view is the episode's first to see; on
 a lattice that is the node's view, as the frame is.
 
@@ -70,7 +71,7 @@ from common.threads import apply_thread_policy
 from nbv.bov.bag import BagOfViews
 from nbv.features.sift import extract_features
 from nbv.recon.visibility import SurfaceVisibility, scene_visibility
-from nbv.rl.config import EnvConfig
+from nbv.rl.config import EnvConfig, RewardConfig
 from nbv.rl.lattice import ViewLattice, build_lattice
 from render.renderer import MitsubaRenderer
 from render.viewpoint import TWO_PI, Viewpoint, viewpoint_to_c2w
@@ -130,6 +131,8 @@ class NBVEnv(EnvBase):
         config: scenes, camera, allowed ranges, episode and Bag of Views settings.
         worker: index of this env among parallel workers; it offsets the scene order.
         seed: seed of the start viewpoints, the render noise and the BoV clustering.
+        reward_terms: training-only reward terms (`TrainConfig.reward`, from `nbv.rl.builders`); by default
+            none, so an env built from an `EnvConfig` alone never reads the true mesh.
 
     Example:
         >>> from render.camera import UAVCamera
@@ -139,9 +142,11 @@ class NBVEnv(EnvBase):
         >>> td = env.rollout(3)
     """
 
-    def __init__(self, config: EnvConfig, worker: int = 0, seed: int = 0) -> None:
+    def __init__(self, config: EnvConfig, worker: int = 0, seed: int = 0,
+                 reward_terms: RewardConfig = RewardConfig()) -> None:
         super().__init__(device="cpu", batch_size=torch.Size([]))
         self.config = config
+        self.reward_terms = reward_terms
         self.worker = worker
         tau, side = config.history, config.obs_size
         self.observation_spec = Composite(
@@ -195,7 +200,7 @@ class NBVEnv(EnvBase):
         self.bov.reset()
         frame, descriptors = self.capture(self._view)
         self.bov.update(descriptors, self._view.azimuth, self._view.elevation)
-        if self.config.coverage_reward:
+        if self.reward_terms.coverage:
             self._seen = self.surface_seen(self._view)
         location = normalise_viewpoint(self._view, self.config)
         self._frames = np.repeat(frame[None], self.config.history, axis=0)
@@ -208,9 +213,9 @@ class NBVEnv(EnvBase):
         view = action_to_viewpoint(tensordict["action"], self._view, self.config)
         frame, descriptors = self.capture(view)
         reward = self.bov.reward(descriptors, view.azimuth, view.elevation)
-        if self.config.coverage_reward:
+        if self.reward_terms.coverage:
             seen = self.surface_seen(view)
-            reward += self.config.coverage_reward * float((seen & ~self._seen).mean())
+            reward += self.reward_terms.coverage * float((seen & ~self._seen).mean())
             self._seen |= seen
         self._progress += wrap_angle(view.azimuth - self._view.azimuth)
         self._view = view

@@ -13,6 +13,8 @@ lists each member's best score and which one was kept; `training.png` overlays t
 from __future__ import annotations
 
 import csv
+import json
+import shutil
 from dataclasses import replace
 from pathlib import Path
 
@@ -23,9 +25,9 @@ from common.provenance import config_record
 from nbv.fanout.config import ExecutorConfig
 from nbv.fanout.executor import run_tasks
 from nbv.fanout.task import Task
-from nbv.rl.checkpoint import copy_policy
-from nbv.rl.config import TrainConfig
-from nbv.rl.train import CHECKPOINT, POLICY, VALIDATION_CSV, render_lattices, train
+from nbv.rl.checkpoint import copy_policy, load_policy
+from nbv.rl.config import MembersConfig, TrainConfig
+from nbv.rl.train import CHECKPOINT, CONFIG_JSON, METRICS_CSV, POLICY, TRAINING_PNG, VALIDATION_CSV, train_run
 from nbv.viz.figures import plot_training_curves
 
 MEMBERS_CSV = "members.csv"
@@ -35,9 +37,9 @@ member whose actor is `policy.pt`)."""
 
 def member_config(config: TrainConfig, member: int) -> TrainConfig:
     """The one-seed run of member `member`: seed S*K + member, folder RUN/member{member}, no members."""
-    seed = config.collector.seed * config.validation.members + member
-    return replace(config, collector=replace(config.collector, seed=seed),
-                   validation=replace(config.validation, members=1), executor=ExecutorConfig(),
+    seed = config.collector.seed * config.members.count + member
+    return replace(config, collector=replace(config.collector, seed=seed), members=MembersConfig(),
+                   executor=ExecutorConfig(),
                    logger=replace(config.logger, out=Path(config.logger.out) / f"member{member}",
                                   progress=config.logger.progress and config.executor.workers == 1))
 
@@ -52,14 +54,14 @@ def best_validation(path: Path) -> dict[str, float]:
 
 
 def train_members(config: TrainConfig) -> Path:
-    """Train the command's members (lattices first, once) and keep the best-validated actor as
-    `RUN/policy.pt`; return the kept member's checkpoint path."""
+    """Train the command's members (`train_run` each, side by side where the executor says; the command
+    renders their lattices first) and keep the best-validated actor as `RUN/policy.pt`; return the kept
+    member's checkpoint path."""
     run = Path(config.logger.out)
     run.mkdir(parents=True, exist_ok=True)
-    write_json(run / "config.json", config_record(config))
-    render_lattices(config)
-    members = [member_config(config, k) for k in range(config.validation.members)]
-    tasks = [Task(f"member {k} (seed {m.collector.seed})", train, {"config": m})
+    write_json(run / CONFIG_JSON, config_record(config))
+    members = [member_config(config, k) for k in range(config.members.count)]
+    tasks = [Task(f"member {k} (seed {m.collector.seed})", train_run, {"config": m})
              for k, m in enumerate(members)]
     with tqdm(total=len(tasks), unit="member", desc=f"train {run.name}",
               disable=not config.logger.progress) as bar:
@@ -72,6 +74,37 @@ def train_members(config: TrainConfig) -> Path:
         log.writerow(["member", "seed", "best_frames", "best_score", "kept"])
         for k, (m, b) in enumerate(zip(members, best)):
             log.writerow([k, m.collector.seed, b["frames"], f"{b['score']:.3f}", int(k == kept)])
-    plot_training_curves({f"member{k} (seed {m.collector.seed})": Path(m.logger.out) / "metrics.csv"
-                          for k, m in enumerate(members)}, run / "training.png")
+    plot_training_curves({f"member{k} (seed {m.collector.seed})": Path(m.logger.out) / METRICS_CSV
+                          for k, m in enumerate(members)}, run / TRAINING_PNG)
     return Path(members[kept].logger.out) / CHECKPOINT
+
+
+def export_run(run: Path, dest: Path, name: str) -> None:
+    """Copy a finished run into `dest` (the shipped policy, `scripts/ship_policy.py`): its policy file (the
+    actor and config, `weights_only`-loadable), config.json, training.png and logs (metrics.csv and, when
+    validated, validation.csv); for a run of several members, members.csv and each member's config.json
+    and logs in memberK/. The run folder in the recorded configs becomes `name` (a relative path), so no
+    machine path is written; nothing else changes."""
+    config, _ = load_policy(run / POLICY)
+    config["logger"]["out"] = name
+    dest.mkdir(parents=True, exist_ok=True)
+    copy_policy(run / POLICY, dest / POLICY, config)
+    write_json(dest / CONFIG_JSON, config)
+    shutil.copyfile(run / TRAINING_PNG, dest / TRAINING_PNG)
+    if not (run / MEMBERS_CSV).is_file():
+        copy_logs(run, dest)
+        return
+    shutil.copyfile(run / MEMBERS_CSV, dest / MEMBERS_CSV)
+    for member in sorted(p for p in run.glob("member*") if p.is_dir()):
+        recorded = json.loads((member / CONFIG_JSON).read_text())
+        recorded["logger"]["out"] = f"{name}/{member.name}"
+        (dest / member.name).mkdir(exist_ok=True)
+        write_json(dest / member.name / CONFIG_JSON, recorded)
+        copy_logs(member, dest / member.name)
+
+
+def copy_logs(run: Path, dest: Path) -> None:
+    """A run's metrics.csv and, if it was validated, its validation.csv."""
+    shutil.copyfile(run / METRICS_CSV, dest / METRICS_CSV)
+    if (run / VALIDATION_CSV).is_file():
+        shutil.copyfile(run / VALIDATION_CSV, dest / VALIDATION_CSV)

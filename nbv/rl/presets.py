@@ -29,7 +29,9 @@ from nbv.rl.config import (
     EnvConfig,
     LatticeConfig,
     LoggerConfig,
+    MembersConfig,
     OptimConfig,
+    RewardConfig,
     TrainConfig,
     ValidationConfig,
 )
@@ -63,11 +65,12 @@ def default_preset() -> TrainConfig:
     env = replace(paper.env, camera=UAVCamera(160, 120), render=RenderSettings(spp=4),
                   bov=BoVConfig(ranges=8, elevation_bands=2, sift=FeatureConfig(backend="opencv")),
                   lattice=LatticeConfig(enabled=True), action_mode="relative", relative_step=0.125,
-                  episode_views=13, coverage_reward=COVERAGE_REWARD)
-    return replace(paper, env=env, collector=CollectorConfig(frames=FRAMES),
-                   optim=OptimConfig(reward_scale=0.1), logger=replace(paper.logger, checkpoint_every=250),
-                   validation=ValidationConfig(validation_scenes=VALIDATION_SCENES, members=MEMBERS),
-                   executor=ExecutorConfig(workers=MEMBERS))
+                  episode_views=13)
+    return replace(paper, env=env, reward=RewardConfig(coverage=COVERAGE_REWARD),
+                   collector=CollectorConfig(frames=FRAMES), optim=OptimConfig(reward_scale=0.1),
+                   logger=replace(paper.logger, checkpoint_every=250),
+                   validation=ValidationConfig(validation_scenes=VALIDATION_SCENES),
+                   members=MembersConfig(count=MEMBERS), executor=ExecutorConfig(workers=MEMBERS))
 
 
 PRESETS = {"default": default_preset, "paper": paper_preset}

@@ -1,12 +1,12 @@
-"""`nbv train`: Soft Actor-Critic over the NBV environment (paper Sec. IV-V-A, Table 1).
+"""The training loop of one `nbv train` run: Soft Actor-Critic over the NBV env (paper Sec. IV-V-A, Table 1).
 
-The loop, top to bottom: build env, networks, loss, optimisers, buffer;
-restore the run folder's checkpoint if there is one; then collect a batch,
-store it, take gradient steps (soft-updating the target critics every
-`target_update_interval` steps), log, and checkpoint (with `training.png`,
-the learning curves so far). With validation buildings, each checkpoint's
-actor is first scored on them (`nbv.rl.validate`, `validation.csv`) and
-`policy.pt` keeps the best one.
+`train_run` trains one seed; the command (`nbv.rl.command.train_command`) renders the view lattices
+first and runs several seeds (`nbv.rl.members`). The loop, top to bottom: build env, networks, loss,
+optimisers, buffer; restore the run folder's checkpoint if there is one; then collect a batch, store
+it, take gradient steps (soft-updating the target critics every `target_update_interval` steps), log,
+and checkpoint (with `training.png`, the learning curves so far). With validation buildings, each
+checkpoint's actor is first scored on them (`nbv.rl.validate`, `validation.csv`) and `policy.pt`
+keeps the best one.
 
 Exact resumption: checkpoints are taken between iterations and hold
 everything the rest of the run depends on: networks, optimisers, replay
@@ -28,19 +28,21 @@ from __future__ import annotations
 import csv
 import json
 import time
+from collections.abc import Iterable
+from dataclasses import dataclass
 from pathlib import Path
 
 import torch
 from tensordict import TensorDictBase
 from torch.utils.tensorboard import SummaryWriter
 from torchrl.data import ReplayBuffer
-from torchrl.objectives import SACLoss
+from torchrl.modules import ProbabilisticActor, ValueOperator
+from torchrl.objectives import SACLoss, SoftUpdate
 from tqdm import tqdm
 
 from common.io import write_json
 from common.provenance import config_from_record, config_record
 from common.threads import set_torch_threads
-from nbv.fanout.executor import run_tasks
 from nbv.rl.builders import (
     make_collector,
     make_environment,
@@ -61,13 +63,18 @@ from nbv.rl.checkpoint import (
     seed_everything,
     set_rng_state,
 )
-from nbv.rl.config import TrainConfig
+from nbv.rl.config import OptimConfig, TrainConfig, upgrade_record
 from nbv.rl.env import NBVEnv
-from nbv.rl.lattice import lattice_tasks
-from nbv.rl.validate import LatticeValidator, validation_env_config
+from nbv.rl.validate import LatticeValidator
 from nbv.viz.figures import plot_training_curves
 
 CHECKPOINT = "checkpoint.pt"
+CONFIG_JSON = "config.json"
+"""The run's whole config (`common.provenance.config_record`)."""
+METRICS_CSV = "metrics.csv"
+"""One row per collected batch (`CSV_FIELDS`)."""
+TRAINING_PNG = "training.png"
+"""The learning curves so far, drawn at each checkpoint."""
 POLICY = "policy.pt"
 """The actor and config alone (a few MB, for planning), written beside every checkpoint; with validation
 buildings, only when the checkpoint's actor scores best on them so far."""
@@ -84,139 +91,192 @@ CSV_FIELDS = ("frames", "updates", "reward_mean", "episode_return", "episodes", 
 
 
 def with_defaults(saved: dict) -> dict:
-    """A recorded run config with the settings added since it was written at their defaults (which
-    reproduce the older behaviour, e.g. render settings); as recorded where it does not parse."""
+    """A recorded run config in today's layout (`upgrade_record`) with the settings added since it was
+    written at their defaults (which reproduce the older behaviour, e.g. render settings); as recorded,
+    upgraded, where it does not parse."""
+    saved = upgrade_record(saved)
     try:
         return config_record(config_from_record(TrainConfig, saved))
     except (TypeError, ValueError):
         return saved
 
 
-def train(config: TrainConfig) -> Path:
-    """Train (or resume training) into `config.logger.out`; return the checkpoint path.
+def train_run(config: TrainConfig) -> Path:
+    """Train (or resume training) one run into `config.logger.out`; return the checkpoint path.
 
-    `policy.pt` beside it holds the actor alone (what `nbv plan --planner policy:RUN/policy.pt` needs). With
-    `--members K` the command trains K seeds (`nbv.rl.members`) and returns the kept member's checkpoint."""
-    if config.validation.members > 1:
-        from nbv.rl.members import train_members  # it runs this function once per member
-
-        return train_members(config)
+    `policy.pt` beside it holds the actor alone (what `nbv plan --planner policy:RUN/policy.pt` needs).
+    One seed: `nbv train` itself (`nbv.rl.command.train_command`) renders the lattices and runs members."""
     run = Path(config.logger.out)
     run.mkdir(parents=True, exist_ok=True)
-    ckpt_path = run / CHECKPOINT
-    resumed = load_checkpoint(ckpt_path) if ckpt_path.exists() else None
-    if resumed is not None:
-        saved = with_defaults(checkpoint_config(resumed, ckpt_path))
-        check_compatible(ckpt_path, saved, config_record(config), RESUMABLE_CHANGES)
-    write_json(run / "config.json", config_record(config))
-    seed = config.collector.seed
-    seed_everything(seed)
+    resumed = resume_state(run / CHECKPOINT, config)
+    write_json(run / CONFIG_JSON, config_record(config))
+    seed_everything(config.collector.seed)
     set_torch_threads(config.collector.threads)  # recorded: an in-process env keeps this choice
 
     # Networks, loss, optimisers, replay buffer.
     actor, critic = make_sac_agent(config.env, config.network)
-    loss_module, target_updater = make_loss_module(actor, critic, config.optim)
-    optim_actor, optim_critic = make_optimizers(loss_module, config.optim)
-    buffer = make_replay_buffer(config.replay_buffer)
-    frames, updates = 0, 0
-    if resumed is not None:
-        loss_module.load_state_dict(resumed["loss"])
-        optim_actor.load_state_dict(resumed["optim_actor"])
-        optim_critic.load_state_dict(resumed["optim_critic"])
-        buffer.load_state_dict(resumed["buffer"])
-        frames, updates = int(resumed["counters"]["frames"]), int(resumed["counters"]["updates"])
-        if frames >= config.collector.frames:
-            return ckpt_path  # the budget is already spent: nothing to do
-
-    # The scenes' view lattices, rendered side by side where the executor says; envs then read the cache.
+    learner = make_learner(actor, critic, config)
+    frames, updates = learner.restore(resumed) if resumed is not None else (0, 0)
+    if frames >= config.collector.frames:
+        return run / CHECKPOINT  # the budget is already spent: nothing to do
     validator = None
     if config.validation.enabled:
         validator = LatticeValidator(config.env, config.validation, config.network)
-    render_lattices(config)
     best = resumed.get("validation") if resumed is not None else None  # {"frames", "score"} so far
 
     # Environment and collector (random actions until init_random_frames).
-    in_process = None  # the env whose state checkpoints carry: one in this process
-    if config.collector.collector == "ray":
-        collector = make_ray_collector(config.env, actor, config.collector, seed + frames, frames)
-    else:
-        env = make_environment(config.env, config.collector.envs, seed + frames)
-        if config.collector.envs == 1:
-            in_process = env.base_env
-            if resumed is not None:
-                in_process.restore(resumed["env"])  # before the collector, which resets the env
-        collector = make_collector(env, actor, config.collector, frames)
+    collector, in_process = make_run_collector(config, actor, frames, resumed)
     if resumed is not None:
         set_rng_state(resumed["rng"])  # after every builder: construction draws random numbers too
 
-    writer = SummaryWriter(str(run / "tensorboard"))
-    csv_path = run / "metrics.csv"
-    new_csv = not csv_path.exists()
     updates_per_batch = round(config.collector.frames_per_batch * config.optim.updates_per_frame)
     last_ckpt = frames
-    bar = tqdm(total=config.collector.frames, initial=frames, unit="frame", desc=f"train {run.name}",
-               disable=not config.logger.progress)
     try:
-        with open(csv_path, "a", newline="") as csv_file:
-            log = csv.DictWriter(csv_file, CSV_FIELDS)
-            if new_csv:
-                log.writeheader()
+        with RunLog(run, config, frames) as log:
             start = time.perf_counter()
             for batch in collector:
                 collect_s = time.perf_counter() - start
                 batch = batch.reshape(-1)
-                buffer.extend(batch)
+                learner.buffer.extend(batch)
                 frames += batch.numel()
 
-                # Gradient steps once the random warm-up is over (Table 1 settings).
                 start = time.perf_counter()
                 losses = {}
-                if frames >= config.collector.init_random_frames:
-                    for _ in range(updates_per_batch):
-                        losses = sac_update(loss_module, optim_actor, optim_critic, buffer.sample(),
-                                            config.optim.reward_scale)
-                        updates += 1
-                        if updates % config.optim.target_update_interval == 0:
-                            target_updater.step()
-                update_s = time.perf_counter() - start
-
-                done = batch["next", "done"].squeeze(-1)
-                returns = batch["next", "episode_reward"][done]
-                row = {"frames": frames, "updates": updates,
-                       "reward_mean": batch["next", "reward"].mean().item(),
-                       "episode_return": returns.mean().item() if done.any() else "",
-                       "episodes": int(done.sum()), "collect_s": collect_s, "update_s": update_s, **losses}
-                log.writerow(row)
-                for key, value in row.items():
-                    if key != "frames" and value != "":
-                        writer.add_scalar(f"train/{key}", value, frames)
-                bar.update(batch.numel())
-                bar.set_postfix(reward=f"{row['reward_mean']:.2f}", updates=updates)
+                if frames >= config.collector.init_random_frames:  # learning starts after the warm-up
+                    losses, updates = learner.gradient_steps(updates_per_batch, updates, config.optim)
+                log.log_batch(batch, frames, updates, losses, collect_s, time.perf_counter() - start)
 
                 if frames - last_ckpt >= config.logger.checkpoint_every or frames >= config.collector.frames:
-                    csv_file.flush()
-                    if validator is not None:
-                        best = validate_checkpoint(validator, run, config, loss_module.state_dict(),
-                                                   {"frames": frames, "updates": updates}, best)
-                    plot_training_curves({run.name: csv_path}, run / "training.png")
-                    write_checkpoint(ckpt_path, config, loss_module, optim_actor, optim_critic, buffer,
-                                     frames, updates, in_process, best)
+                    best = checkpoint_run(run, config, learner, frames, updates, in_process, validator, best,
+                                          log)
                     last_ckpt = frames
                 start = time.perf_counter()
     finally:
-        bar.close()
-        writer.close()
         collector.shutdown()
-    return ckpt_path
+    return run / CHECKPOINT
 
 
-def render_lattices(config: TrainConfig) -> None:
-    """Render the training (--lattice) and validation buildings' view lattices not cached yet, side by side
-    where the executor says, so envs and members then read the cache instead of each rendering them."""
-    tasks = lattice_tasks(config.env) if config.env.lattice.enabled else []
-    if config.validation.enabled:
-        tasks += lattice_tasks(validation_env_config(config.env, config.validation))
-    run_tasks(tasks, config.executor)
+def resume_state(path: Path, config: TrainConfig) -> dict | None:
+    """The run folder's checkpoint if there is one, refused (`CheckpointError`) when its recorded settings
+    differ from `config` beyond `RESUMABLE_CHANGES`."""
+    if not path.exists():
+        return None
+    resumed = load_checkpoint(path)
+    saved = with_defaults(checkpoint_config(resumed, path))
+    check_compatible(path, saved, config_record(config), RESUMABLE_CHANGES)
+    return resumed
+
+
+@dataclass(frozen=True)
+class Learner:
+    """What a run trains and checkpoints: the SAC loss module (actor, twin critics and their targets), the
+    target updater, the two optimisers and the replay buffer."""
+
+    loss: SACLoss
+    target_updater: SoftUpdate
+    optim_actor: torch.optim.Optimizer
+    optim_critic: torch.optim.Optimizer
+    buffer: ReplayBuffer
+
+    def restore(self, resumed: dict) -> tuple[int, int]:
+        """Load a checkpoint's learner state; return its (frames, updates) counters."""
+        self.loss.load_state_dict(resumed["loss"])
+        self.optim_actor.load_state_dict(resumed["optim_actor"])
+        self.optim_critic.load_state_dict(resumed["optim_critic"])
+        self.buffer.load_state_dict(resumed["buffer"])
+        return int(resumed["counters"]["frames"]), int(resumed["counters"]["updates"])
+
+    def gradient_steps(self, steps: int, updates: int, optim: OptimConfig) -> tuple[dict[str, float], int]:
+        """`steps` SAC gradient steps on replay samples (`sac_update`, Table 1 settings), the target critics
+        soft-updated every `target_update_interval` updates; the last step's losses and the update count."""
+        losses = {}
+        for _ in range(steps):
+            losses = sac_update(self.loss, self.optim_actor, self.optim_critic, self.buffer.sample(),
+                                optim.reward_scale)
+            updates += 1
+            if updates % optim.target_update_interval == 0:
+                self.target_updater.step()
+        return losses, updates
+
+
+def make_learner(actor: ProbabilisticActor, critic: ValueOperator, config: TrainConfig) -> Learner:
+    """The SAC loss over `actor` and `critic`, its optimisers and an empty replay buffer."""
+    loss_module, target_updater = make_loss_module(actor, critic, config.optim)
+    optim_actor, optim_critic = make_optimizers(loss_module, config.optim)
+    return Learner(loss_module, target_updater, optim_actor, optim_critic,
+                   make_replay_buffer(config.replay_buffer))
+
+
+def make_run_collector(config: TrainConfig, actor: ProbabilisticActor, frames: int,
+                       resumed: dict | None) -> tuple[Iterable[TensorDictBase], NBVEnv | None]:
+    """The run's collector for the frames still to collect, and its env when that runs in this process
+    (one worker: its state is restored from `resumed` and checkpointed); envs seeded `seed + frames`."""
+    seed = config.collector.seed + frames
+    if config.collector.collector == "ray":
+        return make_ray_collector(config.env, actor, config.collector, seed, frames, config.reward), None
+    env = make_environment(config.env, config.collector.envs, seed, config.reward)
+    in_process = env.base_env if config.collector.envs == 1 else None
+    if in_process is not None and resumed is not None:
+        in_process.restore(resumed["env"])  # before the collector, which resets the env
+    return make_collector(env, actor, config.collector, frames), in_process
+
+
+class RunLog:
+    """A run's training logs: `metrics.csv` (appended to when resuming), TensorBoard scalars under
+    `tensorboard/`, the progress bar, and the learning curves `training.png` at each checkpoint."""
+
+    def __init__(self, run: Path, config: TrainConfig, frames: int) -> None:
+        self.run, self.csv_path = run, run / METRICS_CSV
+        self._writer = SummaryWriter(str(run / "tensorboard"))
+        new_csv = not self.csv_path.exists()
+        self._file = open(self.csv_path, "a", newline="")
+        self._csv = csv.DictWriter(self._file, CSV_FIELDS)
+        if new_csv:
+            self._csv.writeheader()
+        self._bar = tqdm(total=config.collector.frames, initial=frames, unit="frame",
+                         desc=f"train {run.name}", disable=not config.logger.progress)
+
+    def __enter__(self) -> RunLog:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._bar.close()
+        self._writer.close()
+        self._file.close()
+
+    def log_batch(self, batch: TensorDictBase, frames: int, updates: int, losses: dict[str, float],
+                  collect_s: float, update_s: float) -> None:
+        """One `metrics.csv` row (and TensorBoard scalars) for a collected batch and its updates."""
+        done = batch["next", "done"].squeeze(-1)
+        returns = batch["next", "episode_reward"][done]
+        row = {"frames": frames, "updates": updates, "reward_mean": batch["next", "reward"].mean().item(),
+               "episode_return": returns.mean().item() if done.any() else "",
+               "episodes": int(done.sum()), "collect_s": collect_s, "update_s": update_s, **losses}
+        self._csv.writerow(row)
+        for key, value in row.items():
+            if key != "frames" and value != "":
+                self._writer.add_scalar(f"train/{key}", value, frames)
+        self._bar.update(batch.numel())
+        self._bar.set_postfix(reward=f"{row['reward_mean']:.2f}", updates=updates)
+
+    def plot(self) -> None:
+        """Flush `metrics.csv` and draw `training.png` from it."""
+        self._file.flush()
+        plot_training_curves({self.run.name: self.csv_path}, self.run / TRAINING_PNG)
+
+
+def checkpoint_run(run: Path, config: TrainConfig, learner: Learner, frames: int, updates: int,
+                   env: NBVEnv | None, validator: LatticeValidator | None, best: dict | None,
+                   log: RunLog) -> dict | None:
+    """Validate the actor (with validation buildings), draw the curves and write the checkpoint (and the
+    policy file); return the best validation {"frames", "score"} so far."""
+    if validator is not None:
+        best = validate_checkpoint(validator, run, config, learner.loss.state_dict(),
+                                   {"frames": frames, "updates": updates}, best)
+    log.plot()
+    write_checkpoint(run / CHECKPOINT, config, learner.loss, learner.optim_actor, learner.optim_critic,
+                     learner.buffer, frames, updates, env, best)
+    return best
 
 
 def sac_update(loss_module: SACLoss, optim_actor: torch.optim.Optimizer, optim_critic: torch.optim.Optimizer,

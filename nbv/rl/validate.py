@@ -8,29 +8,70 @@ number of views on the building's view lattice (the training cache, so no view i
 and the score is the share of the true surface those views see (`nbv.recon.visibility`, a ray-cast
 depth test at each view's exact pose). `policy.pt` keeps the best-scoring actor. The policy sees the
 nearest nodes' frames as in training; evaluation (`nbv plan`, `nbv online`) renders exact viewpoints.
+
+Model selection across runs (`scripts/select_defaults.py`) scores a run's kept actor, and the baselines,
+the way evaluation does: `validation_score`, the visible coverage of exact-render episodes in the env of
+`evaluation_env_config`, the one recipe of an env that evaluates a trained policy's settings (exact
+renders, no lattice; no training-only reward term, which lives in `TrainConfig.reward`, not in the env).
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import Protocol
 
 import numpy as np
 import torch
 
 from nbv.recon.visibility import SurfaceVisibility, scene_visibility
 from nbv.rl.agent import make_actor
-from nbv.rl.config import EnvConfig, NetworkConfig, ValidationConfig
+from nbv.rl.config import EnvConfig, LatticeConfig, NetworkConfig, ValidationConfig
 from nbv.rl.env import NBVEnv
 from nbv.rl.rollout import policy_views
+from render.settings import RenderSettings
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes.spec import SceneSet
 
 
+class ViewPlanner(Protocol):
+    """Anything that chooses viewpoints in an env (every `nbv.planning` planner)."""
+
+    def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
+        """The chosen viewpoints, the env's start view first."""
+        ...
+
+
 def validation_env_config(env: EnvConfig, validation: ValidationConfig) -> EnvConfig:
-    """The training env on the validation buildings, on view lattices (the training lattice settings),
-    without the coverage reward (its score is the coverage)."""
+    """The training env on the validation buildings, on view lattices (the training lattice settings)."""
     scenes = SceneSet(scene=validation.validation_scenes, up_axis=env.scenes.up_axis)
-    return replace(env, scenes=scenes, lattice=replace(env.lattice, enabled=True), coverage_reward=0.0)
+    return replace(env, scenes=scenes, lattice=replace(env.lattice, enabled=True))
+
+
+def evaluation_env_config(trained: EnvConfig, scenes: SceneSet, render: RenderSettings | None = None,
+                          episode_views: int | None = None) -> EnvConfig:
+    """The env that evaluates a trained env's settings on `scenes`: exact renders (no lattice), the
+    trained state, actions and Bag of Views; `render` and `episode_views` replace the trained ones when
+    given. It has no training-only reward term: those are `TrainConfig.reward`, never an env setting."""
+    changes = {"render": render, "episode_views": episode_views}
+    return replace(trained, scenes=scenes, lattice=LatticeConfig(),
+                   **{key: value for key, value in changes.items() if value is not None})
+
+
+def episode_coverage(planner: ViewPlanner, trained: EnvConfig, scene: str, views: int, seed: int) -> float:
+    """Visible-surface coverage of the true mesh by the planner's `views` viewpoints on `scene` from the
+    start view of `seed` (exact renders, `evaluation_env_config`; surface samples seeded `seed`)."""
+    config = evaluation_env_config(trained, SceneSet(scene=(scene,)))
+    chosen = planner.plan(NBVEnv(config, seed=seed), views)
+    loaded = config.scenes.specs()[0].load()
+    poses = [viewpoint_to_c2w(v, loaded.center()) for v in chosen]
+    return scene_visibility(loaded, config.camera, seed=seed).coverage(poses)
+
+
+def validation_score(planner: ViewPlanner, trained: EnvConfig, scenes: tuple[str, ...], views: int,
+                     episodes: int) -> float:
+    """The model-selection score: mean `episode_coverage` (%) over `scenes` x start views 0 .. episodes-1."""
+    return 100.0 * float(np.mean([episode_coverage(planner, trained, scene, views, seed)
+                                  for scene in scenes for seed in range(episodes)]))
 
 
 class LatticeValidator:

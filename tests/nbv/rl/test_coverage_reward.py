@@ -1,21 +1,26 @@
 """The coverage reward term: W x the share of the true surface a view is the episode's first to see,
-checked against an independent visibility count; off in validation and planning (across a restore:
-test_env's snapshot test)."""
+checked against an independent visibility count; a training-only term that only the training builders
+give an env, so an env built from an `EnvConfig` alone (planning, validation, scoring) never reads the
+true mesh (across a restore: test_env's snapshot test)."""
 
 from __future__ import annotations
 
 import math
+from dataclasses import fields, replace
 
 import pytest
 import torch
 from tensordict import TensorDict
 
+from common.provenance import config_record
 from nbv.bov.config import BoVConfig
 from nbv.features.config import FeatureConfig
 from nbv.recon.visibility import scene_visibility
-from nbv.rl.config import EnvConfig, LatticeConfig, ValidationConfig
+from nbv.rl.agent import make_actor
+from nbv.rl.builders import make_environment, make_sac_agent
+from nbv.rl.config import EnvConfig, LatticeConfig, NetworkConfig, RewardConfig, ValidationConfig
 from nbv.rl.env import NBVEnv
-from nbv.rl.validate import validation_env_config
+from nbv.rl.validate import LatticeValidator, evaluation_env_config, validation_env_config
 from render.camera import UAVCamera
 from render.settings import RenderSettings
 from render.viewpoint import viewpoint_to_c2w
@@ -60,7 +65,7 @@ def new_shares(views: list) -> list[float]:
 
 def test_the_term_adds_w_times_the_newly_seen_share_to_the_bag_of_views_reward():
     bov_only, views = fly(NBVEnv(config(), seed=4))
-    weighted, same_views = fly(NBVEnv(config(coverage_reward=50.0), seed=4))
+    weighted, same_views = fly(NBVEnv(config(), seed=4, reward_terms=RewardConfig(coverage=50.0)))
     assert [v.as_array().tolist() for v in same_views] == [v.as_array().tolist() for v in views]
     shares = new_shares(views)
     assert shares[0] > 0.01 and shares[1] == 0.0  # a first move sees new surface; staying put does not
@@ -72,7 +77,7 @@ def test_on_a_lattice_the_term_counts_what_the_nodes_see(tmp_path, monkeypatch):
     monkeypatch.setenv("NBV_CACHE_DIR", str(tmp_path))
     grid = LatticeConfig(enabled=True, lattice_radii=2, lattice_azimuths=8, lattice_elevations=2)
     bov_only, views = fly(NBVEnv(config(lattice=grid), seed=2))
-    env = NBVEnv(config(lattice=grid, coverage_reward=20.0), seed=2)
+    env = NBVEnv(config(lattice=grid), seed=2, reward_terms=RewardConfig(coverage=20.0))
     weighted, _ = fly(env)
     lattice = env._lattice(env._scene)
     nodes = [lattice.snap(view)[0] for view in views]
@@ -80,34 +85,72 @@ def test_on_a_lattice_the_term_counts_what_the_nodes_see(tmp_path, monkeypatch):
     assert weighted == pytest.approx(expected, abs=1e-4)
 
 
-def test_validation_and_planning_envs_drop_the_term(tmp_path):
-    from nbv.planning.plan import PlanConfig, planning_env_config
-    from nbv.planning.planners import PolicyPlanner
-    from scenes.spec import SceneSpec
+@pytest.fixture
+def no_true_mesh(monkeypatch):
+    """The env's ground-truth visibility raises: whatever steps an env then never reads the true mesh."""
+    import nbv.rl.env
 
-    trained = config(coverage_reward=100.0)
-    validation = validation_env_config(trained, ValidationConfig(validation_scenes=("random:6",)))
-    assert validation.coverage_reward == 0.0
+    def refused(*args, **kwargs):
+        raise AssertionError("the env read the true mesh")
 
-    class Trained(PolicyPlanner):
-        def __init__(self) -> None:
-            self.env_config = trained
+    monkeypatch.setattr(nbv.rl.env, "scene_visibility", refused)
 
-    plan = PlanConfig(scene=SceneSpec(scene="test_building"), planner="policy:x", out=tmp_path)
-    assert planning_env_config(plan, Trained()).coverage_reward == 0.0
+
+def test_an_env_from_an_env_config_alone_never_reads_the_true_mesh(no_true_mesh):
+    trained = config()
+    for env_config in (trained, evaluation_env_config(trained, trained.scenes)):
+        fly(NBVEnv(env_config, seed=1))  # no training-only term: nothing to ray-cast
+    fly(make_environment(trained, 1, 1).base_env)  # the training builder without the reward group: none
+    with pytest.raises(AssertionError, match="read the true mesh"):
+        fly(make_environment(trained, 1, 1, RewardConfig(coverage=10.0)).base_env)
+
+
+def test_the_validator_scores_on_the_true_mesh_but_its_envs_have_no_term(tmp_path, monkeypatch):
+    monkeypatch.setenv("NBV_CACHE_DIR", str(tmp_path))
+    grid = LatticeConfig(lattice_radii=1, lattice_azimuths=4, lattice_elevations=2)
+    validation = ValidationConfig(validation_scenes=("test_building",), validation_episodes=1,
+                                  validation_views=2, validation_points=500)
+    validator = LatticeValidator(config(lattice=grid), validation, NetworkConfig())
+    validator.score(make_actor(5, 16, NetworkConfig()).state_dict())
+    assert [env.reward_terms for env in validator._envs.values()] == [RewardConfig()]
+    assert validation_env_config(config(lattice=grid), validation).lattice.enabled
+
+
+def test_the_run_config_holds_the_term_in_its_reward_group_not_in_the_env():
+    from nbv.cli.train import parse_train
+
+    record = config_record(parse_train(["--coverage-reward", "30", "--out", "run"]))
+    assert record["reward"] == {"coverage": 30.0} and "coverage_reward" not in record["env"]
+    assert not any("coverage" in field.name for field in fields(EnvConfig))
+    with pytest.raises(ValueError, match="training-only term, not an env setting"):
+        EnvConfig(scenes=SceneSet(scene=("test_building",)), coverage_reward=30.0)
 
 
 @pytest.mark.parametrize("weight", [-1.0, math.inf, math.nan])
 def test_bad_weights_are_refused(weight):
     with pytest.raises(ValueError, match="coverage_reward must be finite and >= 0"):
-        config(coverage_reward=weight)
+        RewardConfig(coverage=weight)
 
 
 def test_the_command_line_sets_the_weight():
     from nbv.cli.train import parse_train
     from nbv.rl.presets import COVERAGE_REWARD
 
-    assert parse_train(["--coverage-reward", "300", "--out", "run"]).env.coverage_reward == 300.0
-    assert parse_train(["--out", "run"]).env.coverage_reward == COVERAGE_REWARD == 100.0
-    assert parse_train(["--preset", "paper", "--out", "run"]).env.coverage_reward == 0.0
-    assert parse_train(["--coverage-reward", "0", "--out", "run"]).env.coverage_reward == 0.0
+    assert parse_train(["--coverage-reward", "300", "--out", "run"]).reward.coverage == 300.0
+    assert parse_train(["--out", "run"]).reward.coverage == COVERAGE_REWARD == 100.0
+    assert parse_train(["--preset", "paper", "--out", "run"]).reward.coverage == 0.0
+    assert parse_train(["--coverage-reward", "0", "--out", "run"]).reward.coverage == 0.0
+
+
+def test_training_builds_its_env_with_the_reward_group(tmp_path):
+    from nbv.rl.train import make_run_collector
+    from tests.nbv.rl.test_train import tiny
+
+    run = tiny(tmp_path, 2)
+    run = replace(run, env=config(), reward=RewardConfig(coverage=7.0))
+    actor, _ = make_sac_agent(run.env, run.network)
+    collector, env = make_run_collector(run, actor, 0, None)
+    try:
+        assert env.reward_terms == RewardConfig(coverage=7.0) and env.config == run.env
+    finally:
+        collector.shutdown()

@@ -14,7 +14,7 @@ from nbv.bov.bag import BagOfViews
 from nbv.bov.config import BoVConfig
 from nbv.features.sift import FeatureConfig, extract_features
 from nbv.rl.builders import make_environment
-from nbv.rl.config import EnvConfig
+from nbv.rl.config import EnvConfig, RewardConfig
 from nbv.rl.env import NBVEnv, action_to_viewpoint, check_action, wrap_angle
 from render.camera import UAVCamera
 from render.renderer import MitsubaRenderer
@@ -193,11 +193,11 @@ def test_match_cosine_reaches_the_reward():
 
 @pytest.mark.parametrize("coverage_reward", [0.0, 30.0])  # with the coverage term: what was seen, too
 def test_snapshot_restore_continues_the_episode(coverage_reward):
-    config = tiny_config(max_steps=6, coverage_reward=coverage_reward)
-    a = NBVEnv(config, seed=5)
+    config, terms = tiny_config(max_steps=6), RewardConfig(coverage=coverage_reward)
+    a = NBVEnv(config, seed=5, reward_terms=terms)
     td = a.reset()
     td = a.step(td.set("action", torch.tensor([0.2, 0.4, -0.1])))["next"]
-    b = NBVEnv(config, seed=99)
+    b = NBVEnv(config, seed=99, reward_terms=terms)
     b.restore(a.snapshot())
     resumed = b.reset()
     assert torch.equal(resumed["pixels"], td["pixels"])

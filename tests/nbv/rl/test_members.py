@@ -14,27 +14,27 @@ import torch
 
 from nbv.cli import main
 from nbv.rl.checkpoint import load_checkpoint, load_policy
-from nbv.rl.config import ValidationConfig
+from nbv.rl.command import train_command
+from nbv.rl.config import MembersConfig, ValidationConfig
 from nbv.rl.members import member_config
-from nbv.rl.train import train
 from tests.nbv.rl.test_train import TINY_ENV
-from tests.nbv.rl.test_validate import VALIDATION, cache, validated  # noqa: F401 (fixture)
+from tests.nbv.rl.test_validate import cache, validated  # noqa: F401 (fixture)
 
 
 def test_members_take_disjoint_seeds_and_their_own_folders(tmp_path):
-    config = validated(tmp_path, 4, replace(VALIDATION, members=3))
-    config = replace(config, collector=replace(config.collector, seed=2))
+    config = validated(tmp_path, 4)
+    config = replace(config, collector=replace(config.collector, seed=2), members=MembersConfig(3))
     members = [member_config(config, k) for k in range(3)]
     assert [m.collector.seed for m in members] == [6, 7, 8]  # command seed 2 of 3 members
     assert [m.logger.out for m in members] == [tmp_path / f"member{k}" for k in range(3)]
-    assert all(m.validation.members == 1 and m.validation.validation_scenes == ("test_building",)
+    assert all(m.members.count == 1 and m.validation.validation_scenes == ("test_building",)
                for m in members)
 
 
 def test_members_keep_the_best_validated_actor_under_the_commands_config(tmp_path, cache):  # noqa: F811
-    config = validated(tmp_path / "run", 4, replace(VALIDATION, members=2))
-    config = replace(config, collector=replace(config.collector, seed=1))
-    kept_ckpt = train(config)
+    config = validated(tmp_path / "run", 4)
+    config = replace(config, collector=replace(config.collector, seed=1), members=MembersConfig(2))
+    kept_ckpt = train_command(config)
 
     with open(tmp_path / "run" / "members.csv") as f:
         rows = list(csv.DictReader(f))
@@ -48,9 +48,9 @@ def test_members_keep_the_best_validated_actor_under_the_commands_config(tmp_pat
     command, weights = load_policy(tmp_path / "run" / "policy.pt")
     _, member_weights = load_policy(tmp_path / "run" / f"member{kept}" / "policy.pt")
     assert all(torch.equal(weights[k], member_weights[k]) for k in member_weights)
-    assert command["validation"]["members"] == 2 and command["collector"]["seed"] == 1  # the command's
+    assert command["members"]["count"] == 2 and command["collector"]["seed"] == 1  # the command's
     member = json.loads((tmp_path / "run" / f"member{kept}" / "config.json").read_text())
-    assert member["collector"]["seed"] == 2 + kept and member["validation"]["members"] == 1
+    assert member["collector"]["seed"] == 2 + kept and member["members"]["count"] == 1
     assert (tmp_path / "run" / "training.png").stat().st_size > 10_000
 
     shipped = tmp_path / "shipped"  # what scripts/ship_policy.py commits: no machine path in it
@@ -70,8 +70,11 @@ def test_members_keep_the_best_validated_actor_under_the_commands_config(tmp_pat
 
 
 def test_members_need_validation_buildings(tmp_path, capsys):
+    config = validated(tmp_path, 2)
     with pytest.raises(ValueError, match="validation-scenes"):
-        ValidationConfig(members=2)
+        replace(config, validation=ValidationConfig(), members=MembersConfig(2))
+    with pytest.raises(ValueError, match="members must be >= 1"):
+        MembersConfig(0)
     args = ["train", *TINY_ENV, "--members", "2", "--frames", "2", "--out", str(tmp_path), "--no-progress"]
     assert main(args) == 2
     assert "members (2) are compared on validation buildings" in capsys.readouterr().err

@@ -12,13 +12,22 @@ import torch
 from PIL import Image
 from tensordict import TensorDict
 
+from common.provenance import config_from_record, config_record
 from nbv.bov.config import BoVConfig
 from nbv.cli import main
 from nbv.features.config import FeatureConfig
 from nbv.rl.builders import make_loss_module, make_optimizers, make_sac_agent
-from nbv.rl.checkpoint import CheckpointError, load_checkpoint, save_checkpoint
-from nbv.rl.config import CollectorConfig, EnvConfig, LoggerConfig, OptimConfig, TrainConfig
-from nbv.rl.train import sac_update, train
+from nbv.rl.checkpoint import CheckpointError, load_checkpoint, load_policy, save_checkpoint
+from nbv.rl.config import (
+    CollectorConfig,
+    EnvConfig,
+    LoggerConfig,
+    OptimConfig,
+    RewardConfig,
+    TrainConfig,
+    upgrade_record,
+)
+from nbv.rl.train import sac_update, train_run, with_defaults
 from render.camera import UAVCamera
 from render.settings import RenderSettings
 from scenes.spec import SceneSet
@@ -39,12 +48,12 @@ def tiny(out, frames: int, **collector) -> TrainConfig:
 
 
 def test_one_worker_interrupted_and_resumed_equals_uninterrupted(tmp_path):
-    train(tiny(tmp_path / "straight", 8))
-    train(tiny(tmp_path / "resumed", 4))
+    train_run(tiny(tmp_path / "straight", 8))
+    train_run(tiny(tmp_path / "resumed", 4))
     middle = load_checkpoint(tmp_path / "resumed" / "checkpoint.pt")
     assert middle["counters"]["frames"] == 4 and middle["env"]["steps"] == 1  # stopped mid-episode
-    train(tiny(tmp_path / "resumed", 8))
-    train(tiny(tmp_path / "resumed", 8))  # budget spent: a no-op
+    train_run(tiny(tmp_path / "resumed", 8))
+    train_run(tiny(tmp_path / "resumed", 8))  # budget spent: a no-op
     a = load_checkpoint(tmp_path / "straight" / "checkpoint.pt")
     b = load_checkpoint(tmp_path / "resumed" / "checkpoint.pt")
     assert a["counters"] == b["counters"] == {"frames": 8, "updates": 8}
@@ -116,24 +125,24 @@ def test_auto_alpha_learns_the_temperature_and_fixed_alpha_keeps_it():
 
 
 def test_resuming_with_other_settings_is_refused(tmp_path):
-    train(tiny(tmp_path / "run", 2))
+    train_run(tiny(tmp_path / "run", 2))
     with pytest.raises(CheckpointError, match="collector.seed: checkpoint 7, now 8"):
-        train(tiny(tmp_path / "run", 4, seed=8))
+        train_run(tiny(tmp_path / "run", 4, seed=8))
     config = tiny(tmp_path / "run", 4)
     other_bov = replace(config, env=replace(config.env, bov=replace(config.env.bov, match_cosine=0.6)))
     with pytest.raises(CheckpointError, match="env.bov.match_cosine: checkpoint 0.8, now 0.6"):
-        train(other_bov)
+        train_run(other_bov)
 
 
 def test_a_checkpoint_from_before_the_render_settings_resumes(tmp_path):
-    train(tiny(tmp_path / "run", 2))
+    train_run(tiny(tmp_path / "run", 2))
     path = tmp_path / "run" / "checkpoint.pt"
     state = load_checkpoint(path)
     config = json.loads(state["config"])
     config["env"]["render"] = {key: config["env"]["render"][key]
                                for key in ("spp", "max_depth", "integrator", "variant", "seed")}
     save_checkpoint(path, {**state, "config": json.dumps(config)})
-    train(tiny(tmp_path / "run", 4))
+    train_run(tiny(tmp_path / "run", 4))
     assert load_checkpoint(path)["counters"]["frames"] == 4
 
 
@@ -177,3 +186,53 @@ def test_training_on_a_lattice_renders_it_first_on_the_workers(tmp_path, monkeyp
     assert main(args) == 0
     assert len(list((tmp_path / "cache" / "lattice").glob("*.pt"))) == 1
     assert load_checkpoint(tmp_path / "run" / "checkpoint.pt")["counters"]["frames"] == 2
+
+
+def old_layout(record: dict) -> dict:
+    """A run record as written before the reward and members groups (d439c96): the coverage weight in the
+    env group, the members count in the validation group."""
+    old = json.loads(json.dumps(record))
+    old["env"]["coverage_reward"] = old.pop("reward")["coverage"]
+    old["validation"]["members"] = old.pop("members")["count"]
+    return old
+
+
+def test_a_record_from_before_the_reward_group_reads_into_it():
+    current = config_record(replace(tiny("run", 4), reward=RewardConfig(coverage=30.0)))
+    old = old_layout(current)
+    assert old["env"]["coverage_reward"] == 30.0 and "reward" not in old
+    assert upgrade_record(old) == current and with_defaults(old) == current
+    assert upgrade_record(current) == current  # today's records come back equal
+    assert old["env"]["coverage_reward"] == 30.0  # the record read is left as it was
+
+
+def test_shipped_records_read_into_the_reward_and_members_groups():
+    from pathlib import Path
+
+    from nbv.planning.planners import SHIPPED_POLICY
+
+    config, _ = load_policy(SHIPPED_POLICY)
+    raw = json.loads(torch.load(SHIPPED_POLICY, weights_only=True)["config"])
+    assert raw["env"]["coverage_reward"] == 100.0 and raw["validation"]["members"] == 3  # the old layout
+    assert config["reward"] == {"coverage": 100.0} and config["members"] == {"count": 3}
+    assert "coverage_reward" not in config["env"] and "members" not in config["validation"]
+    recorded = json.loads((Path(SHIPPED_POLICY).parent / "config.json").read_text())
+    assert with_defaults(recorded)["reward"] == {"coverage": 100.0}
+    parsed = config_from_record(TrainConfig, config)
+    assert parsed.reward.coverage == 100.0 and parsed.members.count == 3
+
+
+def test_a_checkpoint_from_before_the_reward_group_resumes_with_its_weight(tmp_path):
+    config = replace(tiny(tmp_path / "run", 4), reward=RewardConfig(coverage=30.0))
+    straight = load_checkpoint(train_run(replace(config, logger=replace(config.logger, out=tmp_path / "a"))))
+    train_run(replace(config, collector=replace(config.collector, frames=2)))
+    path = tmp_path / "run" / "checkpoint.pt"
+    state = load_checkpoint(path)
+    save_checkpoint(path, {**state, "config": json.dumps(old_layout(json.loads(state["config"])))})
+    train_run(config)
+    resumed = load_checkpoint(path)
+    assert resumed["counters"] == straight["counters"] == {"frames": 4, "updates": 4}
+    for key in straight["loss"]:  # resumed exactly, with the recorded weight
+        assert torch.equal(straight["loss"][key], resumed["loss"][key]), key
+    with pytest.raises(CheckpointError, match="reward.coverage: checkpoint 30.0, now 0.0"):
+        train_run(replace(config, reward=RewardConfig(), collector=replace(config.collector, frames=6)))

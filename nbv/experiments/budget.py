@@ -28,8 +28,9 @@ from nbv.experiments.online import scene_folder
 from nbv.fanout.config import ExecutorConfig
 from nbv.fanout.executor import run_stages
 from nbv.fanout.task import Task
-from nbv.planning.plan import PlanSettings, plan_scan
-from nbv.planning.planners import planner_label
+from nbv.planning.config import PlanConfig, PlanSettings
+from nbv.planning.plan import plan_scan
+from nbv.planning.registry import budget_planners, planner_label, replanned
 from nbv.recon.config import MetricsConfig, ReconstructionConfig
 from render.camera import UAVCamera
 from render.settings import RenderSettings
@@ -37,9 +38,10 @@ from scenes.spec import SceneSpec
 
 BUDGETS = (5, 9, 13, 20)
 """View budgets of the curve (the paper's Fig. 1 count, 13, among them)."""
-PLANNERS = ("random", "circle", "greedy", "infogain", "policy", "oracle")
-"""Every planner of the harness (policy: the shipped one); the oracle is an upper bound."""
-REPLANNED = ("circle", "oracle")
+PLANNERS = budget_planners()
+"""Every planner of the harness (policy: the shipped one; the registry's `budget` entries); the oracle is
+an upper bound."""
+REPLANNED = tuple(name for name in replanned() if name in PLANNERS)
 """Planners whose shorter plans are not prefixes of their longer ones: planned at every budget."""
 OUTPUTS = ("budget.md", "budget.json", "budget.png")
 """What a budget study writes into its `out` together."""
@@ -93,9 +95,10 @@ def coverage_auc(budgets: tuple[int, ...], coverage: list[float]) -> float:
 
 def plan_config(config: BudgetConfig, scene: str, planner: str, seed: int, views: int, folder: Path):
     """The `nbv plan` run of one planner, seed and budget, into `folder`, scored against the truth only."""
-    settings = PlanSettings(scene=SceneSpec(scene=scene), views=views, camera=config.camera,
-                            render=config.render, full_scan=False, metrics=config.metrics, recon=config.recon)
-    return settings.plan_config(planner, seed, folder, overwrite=True)
+    settings = PlanSettings(camera=config.camera, render=config.render, full_scan=False,
+                            metrics=config.metrics, recon=config.recon)
+    return PlanConfig(scene=SceneSpec(scene=scene), views=views, planner=planner, seed=seed, out=folder,
+                      overwrite=True, settings=settings)
 
 
 def score_run(folder: Path, views: tuple[int, ...], config: BudgetConfig, scene: str, seed: int) -> None:

@@ -23,8 +23,10 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, fields
 from pathlib import Path
+from typing import Annotated
 
 import numpy as np
+from tyro.conf import arg
 
 from common.io import atomic_folder, write_json, write_text
 from common.provenance import config_record, git_commit
@@ -32,9 +34,11 @@ from nbv.experiments.paper_numbers import FIG1_NBV
 from nbv.fanout.config import ExecutorConfig
 from nbv.fanout.executor import run_stages
 from nbv.fanout.task import Task
-from nbv.planning.plan import PlanSettings, plan_scan, reference_mesh
-from nbv.planning.planners import planner_label
+from nbv.planning.config import PlanConfig, PlanSettings
+from nbv.planning.plan import plan_scan, reference_mesh
+from nbv.planning.registry import entry, planner_label, planner_specs
 from nbv.viz.figures import plot_planner_comparison
+from scenes.spec import SceneSpec
 
 OUTPUTS = ("comparison.json", "comparison.md", "comparison.png")
 """What `nbv compare` writes into `--out` together, beside the run folders."""
@@ -44,9 +48,12 @@ OUTPUTS = ("comparison.json", "comparison.md", "comparison.png")
 class CompareConfig(PlanSettings):
     """Settings of `nbv compare`: every `nbv plan` setting but the planner and seed, which it varies."""
 
-    planners: tuple[str, ...] = ("random", "circle", "greedy")
-    """Planners to compare: policy:CHECKPOINT, policy-sample:CHECKPOINT, random, circle, greedy,
-    hemisphere, infogain, oracle (an upper bound: it uses the true mesh)."""
+    scene: SceneSpec
+    """The target."""
+    views: int | None = None
+    """Number of views; default: the policy's episode, the whole hemisphere, or 13 (paper Fig. 1)."""
+    planners: Annotated[tuple[str, ...], arg(help=f"Planners to compare: {planner_specs()}.")] = (
+        "random", "circle", "greedy")
     seeds: tuple[int, ...] = (0, 1, 2)
     """Seeds per planner."""
     out: Path
@@ -60,6 +67,17 @@ class CompareConfig(PlanSettings):
             raise ValueError("a comparison needs at least one planner and one seed")
         if not self.full_scan:
             raise ValueError("a comparison scores against the full scan too: leave out --no-full-scan")
+        for planner in self.planners:
+            entry(planner)  # an unknown planner fails here, naming every one
+
+    def settings(self) -> PlanSettings:
+        """The plan settings every run of the comparison shares."""
+        return PlanSettings(**{f.name: getattr(self, f.name) for f in fields(PlanSettings)})
+
+    def plan_config(self, planner: str, seed: int, out: Path, overwrite: bool = False) -> PlanConfig:
+        """The `nbv plan` run of one planner and seed under these settings."""
+        return PlanConfig(scene=self.scene, views=self.views, planner=planner, seed=seed, out=out,
+                          overwrite=overwrite, settings=self.settings())
 
 
 COMPARED = (("coverage", "reference", 100.0, "coverage % (ref)"),
@@ -81,9 +99,8 @@ def comparison_tasks(config: CompareConfig) -> tuple[list[Task], list[Task]]:
     """The comparison's units, in two stages: making the full-scan reference (one unit, always run: it is
     cached), then one `plan_scan` per planner and seed, done once its `plan.json` exists."""
     # The reference depends on neither the view count nor the planner: one unit per scene and settings.
-    shared = {f.name: getattr(config, f.name) for f in fields(PlanSettings) if f.name != "views"}
     reference = Task(f"full-scan reference of {config.scene.scene}", reference_mesh,
-                     {"config": PlanSettings(**shared)})
+                     {"scene": config.scene, "settings": config.settings()})
     runs = []
     for planner in config.planners:
         for seed in config.seeds:

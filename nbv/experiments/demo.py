@@ -34,7 +34,8 @@ from nbv.bov.config import BoVConfig
 from nbv.bov.refine import Progress, RefineConfig, refine_dataset
 from nbv.experiments.paper_numbers import FIG7_GENERALISATION, FULL_SCAN_VIEWS, SEC7_SUMMARY, TABLE2
 from nbv.experiments.study import FullScanStudy
-from nbv.planning.plan import PlanConfig, plan_scan
+from nbv.planning.config import PlanConfig, PlanSettings
+from nbv.planning.plan import plan_scan
 from nbv.recon.heatmap import write_heatmap
 from nbv.recon.metrics import SurfaceMetrics, evaluate_surfaces
 from nbv.recon.tsdf import Reconstruction, reconstruct_dataset, save_reconstruction
@@ -147,8 +148,9 @@ def demo_stages(config: DemoConfig, scene: Scene, full: ViewDataset, folder: Pat
 def online_half(config: DemoConfig, folder: Path) -> dict[str, dict[str, Any]]:
     """The policy's one pass around `online_scene`, then random views at its count: `nbv plan` runs."""
     spec = SceneSpec(scene=config.online_scene, up_axis=config.up_axis)
-    shared = {"scene": spec, "camera": config.camera, "render": config.render, "recon": config.recon,
-              "metrics": config.metrics, "full_scan": False, "seed": config.seed, "overwrite": True}
+    settings = PlanSettings(camera=config.camera, render=config.render, recon=config.recon,
+                            metrics=config.metrics, full_scan=False)
+    shared = {"scene": spec, "settings": settings, "seed": config.seed, "overwrite": True}
     policy = plan_scan(PlanConfig(**shared, planner=config.policy, out=folder / "online_policy"))
     rand = plan_scan(PlanConfig(**shared, planner="random", views=policy["views"],
                                 out=folder / "online_random"))

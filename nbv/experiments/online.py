@@ -30,7 +30,7 @@ from nbv.experiments.compare import CompareConfig, compare_planners, comparison_
 from nbv.experiments.paper_numbers import FIG1_NBV, FIG7_GENERALISATION
 from nbv.fanout.config import ExecutorConfig
 from nbv.fanout.executor import run_stages
-from nbv.planning.planners import planner_label
+from nbv.planning.registry import planner_label
 from nbv.recon.config import MetricsConfig
 from nbv.viz.figures import plot_seed_scores
 from render.settings import RenderSettings

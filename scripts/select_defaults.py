@@ -31,7 +31,10 @@ from tqdm import tqdm
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import git_commit
-from nbv.planning.planners import Planner, PolicyPlanner, make_planner
+from nbv.planning.base import Planner
+from nbv.planning.config import PlanSettings
+from nbv.planning.policy import PolicyPlanner
+from nbv.planning.registry import make_planner
 from nbv.recon.visibility import scene_visibility
 from nbv.rl.config import EnvConfig, LatticeConfig
 from nbv.rl.env import NBVEnv
@@ -157,8 +160,8 @@ def score_all(args: argparse.Namespace) -> None:
             score = validation_score(planner, env_config, args.views, args.episodes)
             write_json(saved, {"key": key, "score": score})
         scores.setdefault(name, {})[int(seed)] = score
-    baselines = {name: validation_score(make_planner(name, seed=0), env_config, args.views, args.episodes)
-                 for name in ("random", "circle")}
+    baselines = {name: validation_score(make_planner(name, PlanSettings(), seed=0), env_config, args.views,
+                                        args.episodes) for name in ("random", "circle")}
     seeds = sorted({seed for by_seed in scores.values() for seed in by_seed})
     rows = [[name, len(by_seed), *(f"{by_seed[s]:.1f}" if s in by_seed else "-" for s in seeds),
              f"{np.mean(list(by_seed.values())):.1f} ± {np.std(list(by_seed.values())):.1f}"]

@@ -6,11 +6,14 @@ Names are re-exported lazily (`common.lazy`), so importing a config module stays
 from common.lazy import lazy_exports
 
 _EXPORTS = {
-    "Planner": "nbv.planning.planners",
-    "make_planner": "nbv.planning.planners",
+    "Planner": "nbv.planning.base",
+    "make_planner": "nbv.planning.registry",
+    "PlannerEntry": "nbv.planning.registry",
+    "register": "nbv.planning.registry",
     "InfoGainPlanner": "nbv.planning.infogain",
     "CoverageOraclePlanner": "nbv.planning.oracle",
-    "PlanConfig": "nbv.planning.plan",
+    "PlanConfig": "nbv.planning.config",
+    "PlanSettings": "nbv.planning.config",
     "plan_scan": "nbv.planning.plan",
 }
 __all__ = sorted(_EXPORTS)

@@ -20,6 +20,8 @@ not rendered: their gain is ray cast through the grid. No appearance, no model.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from nbv.planning.base import Planner, check_candidates, sample_viewpoints
@@ -28,6 +30,9 @@ from nbv.recon.occupancy import OccupancyGrid
 from nbv.rl.env import NBVEnv
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes.model import Scene
+
+if TYPE_CHECKING:
+    from nbv.planning.config import PlanSettings
 
 
 def target_grid(scene: Scene, config: OccupancyConfig) -> OccupancyGrid:
@@ -74,3 +79,8 @@ class InfoGainPlanner(Planner):
             view = candidates[int(np.argmax(gains))]
             chosen.append(view)
         return chosen
+
+
+def infogain_planner(settings: PlanSettings, seed: int, checkpoint: str | None) -> InfoGainPlanner:
+    """The registry's `infogain`: K = `settings.candidates`, the grid of `settings.occupancy`."""
+    return InfoGainPlanner(settings.candidates, seed, settings.occupancy)

@@ -31,6 +31,7 @@ planners do not beat it there.
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -40,6 +41,9 @@ from nbv.rl.config import EnvConfig, LatticeConfig
 from nbv.rl.env import NBVEnv
 from nbv.rl.lattice import lattice_axes
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
+
+if TYPE_CHECKING:
+    from nbv.planning.config import PlanSettings
 
 POOL = LatticeConfig(lattice_radii=3, lattice_azimuths=36, lattice_elevations=7)
 """The oracle's fixed candidates: a lattice over the allowed ranges whose odd counts hold the middle
@@ -139,3 +143,8 @@ def improve_by_swaps(chosen: list[int], seen: np.ndarray, passes: int = 5) -> li
         if not swapped:
             break
     return chosen
+
+
+def oracle_planner(settings: PlanSettings, seed: int, checkpoint: str | None) -> CoverageOraclePlanner:
+    """The registry's `oracle`: K = `settings.candidates` random candidates per step in its pool."""
+    return CoverageOraclePlanner(settings.candidates, seed)

@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from nbv.bov.config import BoVConfig
+from nbv.planning.config import PlanSettings
 from nbv.planning.infogain import InfoGainPlanner, target_grid
-from nbv.planning.planners import make_planner
+from nbv.planning.registry import make_planner
 from nbv.recon.config import OccupancyConfig
 from nbv.recon.occupancy import UNKNOWN, OccupancyGrid
 from nbv.rl.config import EnvConfig
@@ -36,12 +37,13 @@ def test_infogain_moves_to_the_candidate_of_highest_gain(monkeypatch):
 
 def test_infogain_is_seeded_starts_at_the_start_view_and_plans_in_the_ranges():
     env = NBVEnv(CONFIG, seed=2)
-    views = make_planner("infogain", seed=2, candidates=3).plan(env, 4)
+    views = make_planner("infogain", PlanSettings(candidates=3), seed=2).plan(env, 4)
     low, high = CONFIG.low, CONFIG.high
     assert len(views) == 4 and views[0] == env.viewpoint  # the env stays at its start: nothing is stepped
     assert all(np.all(low - 1e-9 <= v.as_array()) and np.all(v.as_array() <= high) for v in views)
-    assert views == make_planner("infogain", seed=2, candidates=3).plan(NBVEnv(CONFIG, seed=2), 4)
-    assert views[0] == make_planner("greedy", seed=2, candidates=3).plan(NBVEnv(CONFIG, seed=2), 1)[0]
+    three = PlanSettings(candidates=3)
+    assert views == make_planner("infogain", three, seed=2).plan(NBVEnv(CONFIG, seed=2), 4)
+    assert views[0] == make_planner("greedy", three, seed=2).plan(NBVEnv(CONFIG, seed=2), 1)[0]
 
 
 def test_the_grid_covers_the_padded_target_bounds_and_starts_unknown():

@@ -10,17 +10,10 @@ import pytest
 import torch
 
 from nbv.bov.config import BoVConfig
-from nbv.planning.planners import (
-    SHIPPED_POLICY,
-    CirclePlanner,
-    GreedyBoVPlanner,
-    HemispherePlanner,
-    PolicyPlanner,
-    RandomPlanner,
-    make_planner,
-    planner_label,
-    split_policy_spec,
-)
+from nbv.planning.config import PlanSettings
+from nbv.planning.planners import CirclePlanner, GreedyBoVPlanner, HemispherePlanner, RandomPlanner
+from nbv.planning.policy import PolicyPlanner
+from nbv.planning.registry import SHIPPED_POLICY, entry, make_planner, planner_label, split_spec
 from nbv.rl.builders import make_loss_module, make_optimizers, make_replay_buffer, make_sac_agent
 from nbv.rl.checkpoint import CheckpointError, save_checkpoint
 from nbv.rl.config import EnvConfig, LatticeConfig, LoggerConfig, OptimConfig, TrainConfig
@@ -32,6 +25,7 @@ from render.viewpoint import Viewpoint
 from scenes.spec import SceneSet
 
 TEST_BUILDING = SceneSet(scene=("test_building",))
+PLAN = PlanSettings()
 
 
 def tiny_env(seed: int = 0, **kwargs) -> NBVEnv:
@@ -101,7 +95,7 @@ def save_untrained_policy(path, env: NBVEnv) -> None:
 def test_policy_planner_from_checkpoint(tmp_path):
     env = tiny_env(max_steps=3)
     save_untrained_policy(tmp_path / "checkpoint.pt", env)
-    planner = make_planner(f"policy:{tmp_path / 'checkpoint.pt'}")
+    planner = make_planner(f"policy:{tmp_path / 'checkpoint.pt'}", PLAN)
     assert isinstance(planner, PolicyPlanner) and planner.env_config == env.config  # nested, rebuilt
     views = planner.plan(env, None)  # until the episode ends: at most the step cap
     assert 2 <= len(views) <= 4 and all(in_ranges(v, env.config) for v in views)
@@ -114,28 +108,28 @@ def test_sampled_policy_is_seeded_and_spread(tmp_path):
     (tmp_path / "run").mkdir()
     save_untrained_policy(tmp_path / "run" / "checkpoint.pt", tiny_env())
     spec = f"policy-sample:{tmp_path / 'run' / 'checkpoint.pt'}"
-    sampled = make_planner(spec, seed=1)
+    sampled = make_planner(spec, PLAN, seed=1)
     assert isinstance(sampled, PolicyPlanner) and sampled.sample
     first = sampled.plan(tiny_env(), 4)
-    assert first == make_planner(spec, seed=1).plan(tiny_env(), 4)  # seeded: the same draws
-    assert first != make_planner(spec, seed=2).plan(tiny_env(), 4)
+    assert first == make_planner(spec, PLAN, seed=1).plan(tiny_env(), 4)  # seeded: the same draws
+    assert first != make_planner(spec, PLAN, seed=2).plan(tiny_env(), 4)
     assert all(in_ranges(v, tiny_env().config) for v in first)
-    mode = make_planner(f"policy:{tmp_path / 'run' / 'checkpoint.pt'}", seed=1).plan(tiny_env(), 4)
-    assert mode != first and mode == make_planner(f"policy:{tmp_path / 'run' / 'checkpoint.pt'}",
-                                                  seed=2).plan(tiny_env(), 4)  # the mode ignores the seed
+    mode_spec = f"policy:{tmp_path / 'run' / 'checkpoint.pt'}"
+    mode = make_planner(mode_spec, PLAN, seed=1).plan(tiny_env(), 4)
+    assert mode != first and mode == make_planner(mode_spec, PLAN, seed=2).plan(tiny_env(), 4)  # seed-free
     assert planner_label(spec) == "policy-sample-run" and planner_label("greedy") == "greedy"
 
 
 def test_bad_planner_specs(tmp_path):
     with pytest.raises(ValueError, match="unknown planner"):
-        make_planner("best")
+        make_planner("best", PLAN)
     with pytest.raises(CheckpointError, match="not found"):
-        make_planner("policy:/nonexistent/checkpoint.pt")
+        make_planner("policy:/nonexistent/checkpoint.pt", PLAN)
     flat = {"env": {"scene": ["test_building"], "width": 64, "bov_ranges": 8}, "network": {}}  # old layout
     save_checkpoint(tmp_path / "old.pt", {"config": json.dumps(flat), "loss": {}, "optim_actor": {},
                                           "optim_critic": {}, "buffer": {}, "counters": {}, "rng": {}})
     with pytest.raises(CheckpointError, match="config does not fit.*no field.*bov_ranges"):
-        make_planner(f"policy:{tmp_path / 'old.pt'}")
+        make_planner(f"policy:{tmp_path / 'old.pt'}", PLAN)
 
 
 def test_policy_file_plans_like_its_checkpoint(tmp_path):
@@ -143,15 +137,19 @@ def test_policy_file_plans_like_its_checkpoint(tmp_path):
     save_untrained_policy(tmp_path / "checkpoint.pt", env)
     policy = tmp_path / "policy.pt"  # written beside every checkpoint: the actor and config alone
     assert policy.stat().st_size < (tmp_path / "checkpoint.pt").stat().st_size
-    from_file = make_planner(f"policy:{policy}").plan(tiny_env(max_steps=3), 4)
-    assert from_file == make_planner(f"policy:{tmp_path / 'checkpoint.pt'}").plan(tiny_env(max_steps=3), 4)
+    from_file = make_planner(f"policy:{policy}", PLAN).plan(tiny_env(max_steps=3), 4)
+    same = make_planner(f"policy:{tmp_path / 'checkpoint.pt'}", PLAN).plan(tiny_env(max_steps=3), 4)
+    assert from_file == same
 
 
 def test_bare_policy_spec_is_the_shipped_policy():
-    assert split_policy_spec("policy") == ("policy", str(SHIPPED_POLICY))
-    assert split_policy_spec("policy-sample") == ("policy-sample", str(SHIPPED_POLICY))
-    assert split_policy_spec("policy:run/policy.pt") == ("policy", "run/policy.pt")
-    assert planner_label("policy") == "policy-shipped" and split_policy_spec("random") is None
+    assert split_spec("policy") == (entry("policy"), None)  # no checkpoint: the factory takes the shipped one
+    assert split_spec("policy-sample:run/policy.pt") == (entry("policy-sample"), "run/policy.pt")
+    assert split_spec("random") == (entry("random"), None) and not entry("random").checkpoint
+    assert planner_label("policy") == "policy-shipped"
+    made = make_planner("policy", PLAN).actor.state_dict()
+    shipped = PolicyPlanner(SHIPPED_POLICY).actor.state_dict()
+    assert made.keys() == shipped.keys() and all(torch.equal(made[k], shipped[k]) for k in made)
 
 
 def test_shipped_policy_is_the_default_training_command_and_plans():
@@ -165,7 +163,7 @@ def test_shipped_policy_is_the_default_training_command_and_plans():
     default = config_record(parse_train(["--out", "runs/default"]))
     for group in ("env", "collector", "replay_buffer", "optim", "network", "validation"):
         assert shipped[group] == default[group], group  # `nbv train --out runs/default` retrains it
-    planner = make_planner("policy")
+    planner = make_planner("policy", PLAN)
     assert isinstance(planner, PolicyPlanner) and planner.env_config.bov.elevation_bands == 2
     env = NBVEnv(replace(planner.env_config, scenes=TEST_BUILDING, lattice=LatticeConfig()))
     views = planner.plan(env, 3)

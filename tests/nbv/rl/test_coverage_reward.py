@@ -79,8 +79,9 @@ def test_on_a_lattice_the_term_counts_what_the_nodes_see(tmp_path, monkeypatch):
 
 
 def test_validation_and_planning_envs_drop_the_term(tmp_path):
-    from nbv.planning.plan import PlanConfig, planning_env_config
-    from nbv.planning.planners import PolicyPlanner
+    from nbv.planning.config import PlanConfig
+    from nbv.planning.plan import planning_env_config
+    from nbv.planning.policy import PolicyPlanner
     from scenes.spec import SceneSpec
 
     trained = config(coverage_reward=100.0)

@@ -109,13 +109,13 @@ def test_relative_steps_on_a_lattice_accumulate_from_the_exact_viewpoint(tmp_pat
 
 def test_planning_env_renders_exact_viewpoints(tmp_path):
     from nbv.planning.plan import planning_env_config
-    from nbv.planning.planners import PolicyPlanner
+    from nbv.planning.policy import PolicyPlanner
 
     class Trained(PolicyPlanner):
         def __init__(self) -> None:
             self.env_config = config()
 
-    from nbv.planning.plan import PlanConfig
+    from nbv.planning.config import PlanConfig
     from scenes.spec import SceneSpec
 
     plan = PlanConfig(scene=SceneSpec(scene="test_building"), planner="policy:x", out=tmp_path)

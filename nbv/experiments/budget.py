@@ -30,12 +30,18 @@ from common.provenance import config_record, git_commit, run_cache
 from nbv.experiments.planner_study import PlannerStudy, StudyRun, run_study
 from nbv.fanout.config import ExecutorConfig
 from nbv.planning.config import PlanSettings
-from nbv.planning.registry import budget_planners, entries
+from nbv.planning.registry import budget_planners, replanned
 from nbv.recon.config import MetricsConfig
 from nbv.viz.paper import plot_budget_curves
 
 BUDGETS = (5, 9, 13, 20)
 """View budgets of the curve (the paper's Fig. 1 count, 13, among them)."""
+PLANNERS = budget_planners()
+"""Every planner of the harness (policy: the shipped one; the registry's `budget` entries at import: the
+config's default is read when it is made, so a planner registered later joins it); the oracle is an upper
+bound."""
+REPLANNED = tuple(name for name in replanned() if name in PLANNERS)
+"""Planners whose shorter plans are not prefixes of their longer ones: planned at every budget."""
 OUTPUTS = ("budget.md", "budget.json", "budget.png")
 """What a budget study writes into its `out` together."""
 RUNS = "{scene}/{planner}-v{views}-seed{seed}"
@@ -75,11 +81,6 @@ class BudgetConfig:
         return PlannerStudy(scenes=self.scenes, planners=self.planners, seeds=self.seeds,
                             budgets=self.budgets, curves=True, settings=self.settings, out=runs, runs=RUNS,
                             executor=self.executor)
-
-
-def replanned() -> tuple[str, ...]:
-    """The registry's budget planners planned afresh at every budget (their shorter plans are no prefixes)."""
-    return tuple(e.name for e in entries() if e.budget and not e.prefixes)
 
 
 def coverage_auc(budgets: tuple[int, ...], coverage: list[float]) -> float:
@@ -150,7 +151,7 @@ def budget_markdown(rows: dict[str, list[dict]], config: BudgetConfig) -> str:
     lines = [f"# Coverage against view budget (commit {git_commit()})", "",
              f"Mean ± std over seeds {', '.join(map(str, config.seeds))} (the 'mean' rows: over buildings); "
              f"coverage within {config.settings.metrics.threshold_cm:g} cm. Sequential planners are scored "
-             f"on prefixes of their {config.budgets[-1]}-view plan; {', '.join(replanned())} plan afresh at "
+             f"on prefixes of their {config.budgets[-1]}-view plan; {', '.join(REPLANNED)} plan afresh at "
              "every budget. AUC: mean over the budget range (trapezoid rule). The oracle uses the true mesh "
              "and maximises visible coverage: an upper bound of that measure, not a planner a user has."]
     for measure, title in MEASURES:

@@ -15,6 +15,7 @@ _EXPORTS = {
     "PlanConfig": "nbv.planning.config",
     "PlanSettings": "nbv.planning.config",
     "plan_scan": "nbv.planning.plan",
+    "PlanningWorld": "nbv.planning.world",
 }
 __all__ = sorted(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -1,6 +1,6 @@
 """`nbv plan`: plan a scan with one planner, capture it, reconstruct it, score it.
 
-Stages, each a verb: `choose_views` (the planner, on a one-worker env),
+Stages, each a verb: `choose_views` (the planner, in a `PlanningWorld`),
 `capture_dataset` (RGB-D views on disk), `reconstruct_dataset` (TSDF fusion),
 `evaluate` (`nbv evaluate`'s function, so `metrics.json` has its format)
 against the ground-truth mesh (`gt`) and against the full-scan reconstruction
@@ -26,13 +26,12 @@ from common.provenance import config_record
 from common.threads import chosen_threads, limit_torch_threads, worker_threads
 from nbv.planning.base import Planner
 from nbv.planning.config import PlanConfig, PlanSettings
-from nbv.planning.policy import PolicyPlanner
 from nbv.planning.registry import make_planner
+from nbv.planning.world import PlanningWorld
 from nbv.recon.evaluate import EvaluateConfig, GroundTruth, write_evaluation
 from nbv.recon.metrics import load_geometry
 from nbv.recon.tsdf import reconstruct_dataset, save_reconstruction
-from nbv.rl.config import EnvConfig, LatticeConfig
-from nbv.rl.env import NBVEnv
+from nbv.rl.config import EnvConfig
 from nbv.viz.figures import plot_trajectory
 from render.capture import capture_dataset
 from render.dataset import read_dataset
@@ -53,19 +52,9 @@ def scan_env_config(scene: SceneSpec, settings: PlanSettings) -> EnvConfig:
 
 
 def planning_env_config(config: PlanConfig, planner: Planner) -> EnvConfig:
-    """The env the planner works in: a policy's training settings on this scene, else `scan_env_config`.
-
-    Planning always renders exact viewpoints: a policy trained on a view lattice plans without it. Its
-    episode ends where the protocol says (one pass, or the view budget), whatever budget it trained with,
-    and no reward reads the true mesh.
-    """
-    own = scan_env_config(config.scene, config.settings)
-    if isinstance(planner, PolicyPlanner):
-        trained = planner.env_config
-        render = replace(trained.render, variant=config.settings.render.variant)
-        return replace(trained, scenes=own.scenes, render=render, lattice=LatticeConfig(), episode_views=0,
-                       coverage_reward=0.0)
-    return own
+    """The env settings the planner works in: the ones it declares (`Planner.planning_env`) given the
+    plan's own, `scan_env_config` (a policy: its training settings on this scene, exact renders)."""
+    return planner.planning_env(scan_env_config(config.scene, config.settings))
 
 
 def choose_views(config: PlanConfig, planner: Planner,
@@ -79,14 +68,15 @@ def choose_views(config: PlanConfig, planner: Planner,
     Torch runs on the thread policy's count (`common.threads.worker_threads`, 1) while planning, unless
     this process already chose its threads; the previous count is restored afterwards.
     """
-    env = NBVEnv(env_config, seed=config.seed)
+    world = PlanningWorld(env_config, seed=config.seed)
     threads = 0 if chosen_threads() is not None else worker_threads()
     with limit_torch_threads(threads):
         start = time.perf_counter()
-        views = planner.plan(env, config.views)
+        views = planner.plan(world, config.views)
         seconds = time.perf_counter() - start
-    camera = (env.setup_seconds + flown_seconds(env.render_seconds, env.views_rendered, len(views))
-              + flown_seconds(env.depth_seconds, env.depths_rendered, len(views)))
+    clock = world.source
+    camera = (clock.setup_seconds + flown_seconds(clock.render_seconds, clock.views_rendered, len(views))
+              + flown_seconds(clock.depth_seconds, clock.depths_rendered, len(views)))
     return views, seconds, min(camera, seconds)
 
 

@@ -1,17 +1,18 @@
 """View planners behind one interface: the trained policy and the baselines (docs/rl.md).
 
-`Planner.plan(env, views)` returns the viewpoints to capture, in order. The
-env (a one-worker `NBVEnv` on the target scene) supplies the allowed ranges,
-the start viewpoint, rendering, features and the Bag of Views; the planners
-that need no images (random, circle, hemisphere) use only its config. The
+`Planner.plan(world, views)` returns the viewpoints to capture, in order. The
+world (`world.py`) supplies the allowed ranges, the camera, the start
+viewpoint, the view source (rendering, features) and a Bag of Views; the
+planners that need no images (random, circle, hemisphere) use only the ranges
+and the camera. The
 interface and the candidate scheme of the greedy planners are in `base.py`; the
 planners by name in `registry.py`.
 
 - `RandomPlanner`: viewpoints drawn uniformly in the allowed ranges.
 - `CirclePlanner`: evenly spaced azimuths at the middle radius and elevation.
-- `GreedyBoVPlanner`: from the env's start view, at each step render K
+- `GreedyBoVPlanner`: from the start view, at each step render K
   candidate viewpoints drawn uniformly in the ranges and move to the one of
-  highest Bag of Views reward (Sec. IV's reward under the env's `bov` config, no learning).
+  highest Bag of Views reward (Sec. IV's reward under the plan's `bov` config, no learning).
 - `HemispherePlanner`: the full-coverage hemisphere scan (Sec. V-B), the
   paper's reference.
 - `InfoGainPlanner` (`infogain.py`): greedy on volumetric information gain,
@@ -21,7 +22,7 @@ planners by name in `registry.py`.
   true surface among greedy's candidates and a fixed lattice (greedy with
   restarts, then swaps); it uses the ground-truth mesh, so it is an upper-bound
   reference, not a planner a real UAV could run.
-- `PolicyPlanner` (`policy.py`): a trained SAC actor from the env's start view, acting on
+- `PolicyPlanner` (`policy.py`): a trained SAC actor from the start view, acting on
   its distribution's mode (`policy:CHECKPOINT`, deterministic) or on seeded
   draws from it (`policy-sample:CHECKPOINT`, the max-entropy policy SAC
   trained, whose action dimensions the reward does not constrain stay spread).
@@ -29,19 +30,18 @@ planners by name in `registry.py`.
 
 from __future__ import annotations
 
-import copy
 import math
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from nbv.planning.base import Planner, check_candidates, sample_viewpoints
-from nbv.rl.env import NBVEnv
 from render.scan import HemispherePlan, hemisphere_scan
 from render.viewpoint import TWO_PI, Viewpoint
 
 if TYPE_CHECKING:
     from nbv.planning.config import PlanSettings
+    from nbv.planning.world import PlanningWorld
 
 
 class RandomPlanner(Planner):
@@ -52,10 +52,10 @@ class RandomPlanner(Planner):
     def __init__(self, seed: int = 0, default_views: int = 13) -> None:
         self.seed, self.default_views = seed, default_views
 
-    def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
+    def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """`views` (default 13, the paper's Fig. 1 count) random viewpoints."""
         count = self.default_views if views is None else views
-        return sample_viewpoints(env.config, count, np.random.default_rng(self.seed))
+        return sample_viewpoints(world.low, world.high, count, np.random.default_rng(self.seed))
 
 
 class CirclePlanner(Planner):
@@ -66,10 +66,10 @@ class CirclePlanner(Planner):
     def __init__(self, default_views: int = 13) -> None:
         self.default_views = default_views
 
-    def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
+    def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """`views` (default 13) viewpoints on one ring."""
         count = self.default_views if views is None else views
-        mid = (env.config.low + env.config.high) / 2.0
+        mid = (world.low + world.high) / 2.0
         return [Viewpoint(float(mid[0]), TWO_PI * k / count, float(mid[2])) for k in range(count)]
 
 
@@ -78,10 +78,10 @@ class HemispherePlanner(Planner):
 
     name = "hemisphere"
 
-    def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
+    def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """Every viewpoint of the scan (`views`, if given, must not be smaller than it)."""
-        radius = (env.config.radius_min + env.config.radius_max) / 2.0
-        scan = hemisphere_scan(env.config.camera, HemispherePlan(radius=radius))
+        radius = (world.env.radius_min + world.env.radius_max) / 2.0
+        scan = hemisphere_scan(world.camera, HemispherePlan(radius=radius))
         if views is not None and views < len(scan):
             raise ValueError(f"the hemisphere scan has {len(scan)} views; --views {views} would cut it")
         return scan
@@ -96,19 +96,20 @@ class GreedyBoVPlanner(Planner):
         self.candidates = check_candidates("greedy", candidates)
         self.seed, self.default_views = seed, default_views
 
-    def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
+    def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """The start view, then `views - 1` greedy moves (default 13 views in all)."""
         rng = np.random.default_rng(self.seed)
-        env.reset()
-        chosen = [env.viewpoint]
+        source, bov, start = world.source, world.bov, world.start
+        bov.update(source.capture(start)[1], start.azimuth, start.elevation)  # as the env learns its first
+        chosen = [start]
         for _ in range((self.default_views if views is None else views) - 1):
             best, best_reward, best_descriptors = None, -math.inf, None
-            for view in sample_viewpoints(env.config, self.candidates, rng):
-                _, descriptors = env.capture(view)
-                reward = copy.deepcopy(env.bov).reward(descriptors, view.azimuth, view.elevation)
+            for view in sample_viewpoints(world.low, world.high, self.candidates, rng):
+                _, descriptors = source.capture(view)
+                reward = bov.reward(descriptors, view.azimuth, view.elevation, commit=False)
                 if reward > best_reward:
                     best, best_reward, best_descriptors = view, reward, descriptors
-            env.bov.update(best_descriptors, best.azimuth, best.elevation)
+            bov.update(best_descriptors, best.azimuth, best.elevation)
             chosen.append(best)
         return chosen
 

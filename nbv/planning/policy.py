@@ -8,6 +8,7 @@ Without a checkpoint, the shipped policy (`registry.SHIPPED_POLICY`).
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -16,17 +17,22 @@ from nbv.planning.base import Planner
 from nbv.planning.registry import SHIPPED_POLICY
 from nbv.rl.agent import make_actor
 from nbv.rl.checkpoint import CheckpointError, load_policy
-from nbv.rl.config import EnvConfig, NetworkConfig
+from nbv.rl.config import EnvConfig, LatticeConfig, NetworkConfig
 from nbv.rl.env import NBVEnv
 from nbv.rl.rollout import policy_views
 from render.viewpoint import Viewpoint
 
 if TYPE_CHECKING:
     from nbv.planning.config import PlanSettings
+    from nbv.planning.world import PlanningWorld
 
 
 class PolicyPlanner(Planner):
-    """A trained SAC policy from the env's start view: its distribution's mode, or seeded draws from it."""
+    """A trained SAC policy from the start view: its distribution's mode, or seeded draws from it.
+
+    It flies its own `NBVEnv` (`planning_env`: its training settings on the plan's scene) on the
+    world's view source, so its renders count on the plan's clock.
+    """
 
     name = "policy"
 
@@ -46,17 +52,29 @@ class PolicyPlanner(Planner):
             raise CheckpointError(f"checkpoint {checkpoint}: actor weights do not fit: {err}") from err
         self.actor.eval()
 
-    def check_env(self, env: NBVEnv) -> None:
-        """Refuse an env whose state or action differs from the one the policy was trained on."""
+    def planning_env(self, own: EnvConfig) -> EnvConfig:
+        """Its training settings on the plan's scenes, rendering exact viewpoints in the plan's Mitsuba
+        variant: a policy trained on a view lattice plans without it. Its episode ends where the protocol
+        says (one pass, or the view budget), whatever budget it trained with, and no reward reads the
+        true mesh."""
+        trained = self.env_config
+        render = replace(trained.render, variant=own.render.variant)
+        return replace(trained, scenes=own.scenes, render=render, lattice=LatticeConfig(), episode_views=0,
+                       coverage_reward=0.0)
+
+    def check_env(self, config: EnvConfig) -> None:
+        """Refuse env settings whose state or action differ from those the policy was trained on."""
         for key in ("history", "obs_size", "radius_min", "radius_max", "elevation_min_deg",
                     "elevation_max_deg", "action_mode", "relative_step"):
-            trained, now = getattr(self.env_config, key), getattr(env.config, key)
+            trained, now = getattr(self.env_config, key), getattr(config, key)
             if now != trained:
                 raise ValueError(f"the policy was trained with {key}={trained!r}, the env has {now!r}")
 
-    def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
-        """Act until the episode ends (one pass or the step cap), or for exactly `views` views."""
-        self.check_env(env)
+    def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
+        """Act until the episode ends (one pass or the step cap), or for exactly `views` views, in an env
+        on the world's settings and view source (the env draws the world's start view)."""
+        self.check_env(world.env)
+        env = NBVEnv(world.env, seed=world.seed, source=world.source)
         return policy_views(self.actor, env, views, self.sample, self.seed)
 
 

@@ -99,7 +99,7 @@ def test_choose_views_plans_on_the_thread_policy_and_restores_torch(tmp_path, mo
     from nbv.planning.plan import choose_views, scan_env_config
 
     class Recorder:
-        def plan(self, env, views):
+        def plan(self, world, views):
             seen.append(torch.get_num_threads())
             return []
 
@@ -128,17 +128,17 @@ def test_choose_views_counts_the_simulated_camera_apart_from_deciding(tmp_path):
     from nbv.planning.plan import choose_views, scan_env_config
 
     class Looker:  # renders 3 candidates beside its start view, flies to one view
-        def plan(self, env, views):
-            self.env = env
-            env.reset()
-            for azimuth in (0.5, 1.5, 2.5):
-                env.render_view(Viewpoint(env.viewpoint.radius, azimuth, env.viewpoint.elevation))
-            return [env.viewpoint]
+        def plan(self, world, views):
+            self.world = world
+            start = world.start
+            for azimuth in (start.azimuth, 0.5, 1.5, 2.5):
+                world.source.render_rgb(Viewpoint(start.radius, azimuth, start.elevation))
+            return [start]
 
     config = PlanConfig(scene=SceneSpec(scene="test_building"), out=tmp_path,
                         settings=PlanSettings(camera=UAVCamera(48, 36), render=RenderSettings(spp=1)))
     looker = Looker()
     views, seconds, camera = choose_views(config, looker, scan_env_config(config.scene, config.settings))
-    env = looker.env
-    assert len(views) == 1 and env.views_rendered == 4 and env.setup_seconds > 0
-    assert camera == pytest.approx(env.setup_seconds + env.render_seconds / 4) and camera < seconds
+    clock = looker.world.source
+    assert len(views) == 1 and clock.views_rendered == 4 and clock.setup_seconds > 0
+    assert camera == pytest.approx(clock.setup_seconds + clock.render_seconds / 4) and camera < seconds

@@ -11,8 +11,9 @@ from tensordict import TensorDict
 
 from nbv.bov.config import BoVConfig
 from nbv.features.sift import extract_features
+from nbv.features.source import gray_frame
 from nbv.rl.config import EnvConfig, LatticeConfig
-from nbv.rl.env import NBVEnv, gray_frame
+from nbv.rl.env import NBVEnv
 from nbv.rl.lattice import ViewLattice, lattice_axes
 from render.camera import UAVCamera
 from render.settings import RenderSettings
@@ -72,7 +73,7 @@ def test_env_on_a_lattice_sees_cached_node_renders_and_reuses_the_cache(monkeypa
     lattice = env._lattice(env._scene)
     node, index = lattice.snap(start)
     assert np.array_equal(td["pixels"][-1].numpy(), lattice.frames[index])
-    renderer = env._renderer(env._scene)
+    renderer = env.source.renderer(env._scene)
     rgb = renderer.render_rgb(viewpoint_to_c2w(node, renderer.center), seed=index)
     frame, descriptors = lattice.observe(index)
     assert np.array_equal(frame, gray_frame(rgb, 16))

@@ -188,7 +188,7 @@ class ToyPlanner(Planner):
 
     name = "toy"
 
-    def plan(self, env, views: int | None) -> list[Viewpoint]:
+    def plan(self, world, views: int | None) -> list[Viewpoint]:
         return [Viewpoint(2.0, 0.7 * k, 0.5) for k in range(views or 3)]
 
 

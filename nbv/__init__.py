@@ -11,7 +11,7 @@ _EXPORTS = {
     "extract_features": "nbv.features.sift",
     "TSDFFusion": "nbv.recon.tsdf", "evaluate_surfaces": "nbv.recon.metrics",
     "NBVEnv": "nbv.rl.env", "EnvConfig": "nbv.rl.config",
-    "make_planner": "nbv.planning.planners",
+    "make_planner": "nbv.planning.registry",
 }
 __all__ = sorted(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -5,7 +5,7 @@ training buildings (`TRAIN_SCENES`) and is scored on validation buildings that n
 (`VALIDATION_SCENES`: training-split `random:SEED` buildings; the test buildings alpine_chalet,
 imperial_temple and random:SEED with SEED % 5 == 0 are never touched here). The score is the policy's
 mode over `--episodes` start views per building, rendered at exact viewpoints, scored by the
-visible-surface coverage of the true mesh (`nbv.rl.validate.validation_score`, the library's
+visible-surface coverage of the true mesh (`nbv.planning.selection.validation_score`, the library's
 model-selection score). This script keeps the rounds' candidates and runs them.
 
     python scripts/select_defaults.py train --round 2 --runs runs/selection --frames 6000 --jobs 3
@@ -31,9 +31,11 @@ from tqdm import tqdm
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import git_commit
-from nbv.planning.planners import PolicyPlanner, make_planner
+from nbv.planning.config import PlanSettings
+from nbv.planning.policy import PolicyPlanner
+from nbv.planning.registry import make_planner
+from nbv.planning.selection import validation_score
 from nbv.rl.presets import TRAIN_SCENES, VALIDATION_SCENES
-from nbv.rl.validate import validation_score
 from nbv.viz.figures import plot_seed_scores
 
 BASE = ("--preset", "paper", "--width", "160", "--height", "120", "--spp", "4", "--feature-backend", "opencv",
@@ -137,8 +139,9 @@ def score_all(args: argparse.Namespace) -> None:
             score = validation_score(planner, env_config, VALIDATION_SCENES, args.views, args.episodes)
             write_json(saved, {"key": key, "score": score})
         scores.setdefault(name, {})[int(seed)] = score
-    baselines = {name: validation_score(make_planner(name, seed=0), env_config, VALIDATION_SCENES, args.views,
-                                        args.episodes) for name in ("random", "circle")}
+    baselines = {name: validation_score(make_planner(name, PlanSettings(), seed=0), env_config,
+                                        VALIDATION_SCENES, args.views, args.episodes)
+                 for name in ("random", "circle")}
     seeds = sorted({seed for by_seed in scores.values() for seed in by_seed})
     rows = [[name, len(by_seed), *(f"{by_seed[s]:.1f}" if s in by_seed else "-" for s in seeds),
              f"{np.mean(list(by_seed.values())):.1f} ± {np.std(list(by_seed.values())):.1f}"]

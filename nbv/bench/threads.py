@@ -33,9 +33,9 @@ from nbv.bench import BenchResult
 from nbv.bench.bov import render_views
 from nbv.bov.bag import BagOfViews
 from nbv.features.sift import FeatureConfig, extract_features
+from nbv.features.source import gray_frame
 from nbv.rl.agent import make_actor
 from nbv.rl.config import EnvConfig
-from nbv.rl.env import gray_frame
 from render.camera import UAVCamera
 from scenes import DEFAULT_SCENE
 from scenes.spec import SceneSet

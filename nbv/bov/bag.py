@@ -392,16 +392,30 @@ class BagOfViews(nn.Module):
         self.word_count[r] = k
         self.updates[r] += 1
 
-    def reward(self, descriptors: torch.Tensor | np.ndarray, azimuth: float, elevation: float = 0.0) -> float:
+    def reward(self, descriptors: torch.Tensor | np.ndarray, azimuth: float, elevation: float = 0.0,
+               commit: bool = True) -> float:
         """Paper Sec. IV: update the view's range, return dist(new vocabulary, old) - 1.
+
+        With `commit=False` the reward is the same but the bag is left exactly as it was (a look-ahead:
+        only the view's range changes in an update, and its draws depend only on the state, so restoring
+        that range's rows restores everything).
 
         Shape:
             - descriptors: :math:`(M, D)`.
         """
         r = self.range_of(azimuth, elevation)
         old, old_mask = self.words[r].clone(), self.word_mask[r].clone()
+        saved = None if commit else [buffer[r].clone() for buffer in self._per_range()]
         self.update(descriptors, azimuth, elevation)
-        return float(bov_reward(self.words[r], old, self.word_mask[r], old_mask, self.match_cosine))
+        reward = float(bov_reward(self.words[r], old, self.word_mask[r], old_mask, self.match_cosine))
+        if saved is not None:
+            for buffer, rows in zip(self._per_range(), saved):
+                buffer[r] = rows
+        return reward
+
+    def _per_range(self) -> tuple[torch.Tensor, ...]:
+        """Every buffer, each indexed by range first: all an update changes."""
+        return (self.words, self.word_count, self.memory, self.memory_count, self.seen, self.updates)
 
     def reset(self) -> None:
         """Forget every vocabulary and memory."""

@@ -1,5 +1,5 @@
-"""`nbv plan SCENE --planner {policy[-sample]:CKPT,random,circle,greedy,hemisphere,infogain,oracle}
-[--views N] --out DIR`."""
+"""`nbv plan SCENE --planner PLANNER [--views N] --out DIR`: the planners are listed by `--help`, from
+`nbv.planning.registry`."""
 
 from __future__ import annotations
 
@@ -7,7 +7,8 @@ import json
 from collections.abc import Sequence
 
 from nbv.cli.parse import parse
-from nbv.planning.plan import PlanConfig, plan_scan
+from nbv.planning.config import PlanConfig
+from nbv.planning.plan import plan_scan
 
 
 def main(args: Sequence[str], prog: str) -> int:

@@ -1,5 +1,6 @@
-"""The paper's experiments: its numbers, the demo, its tables and figures, planner comparisons and rendering
-ablations (each a config + a run).
+"""The paper's experiments: its numbers, the demo, its tables and figures, planner studies (comparisons,
+online evaluation, budget curves: presets of one `PlannerStudy`) and rendering ablations (each a config + a
+run).
 
 Names are re-exported lazily (`common.lazy`), so importing a config module stays light.
 """
@@ -20,6 +21,10 @@ _EXPORTS = {
     "run_ablations": "nbv.experiments.ablate",
     "CompareConfig": "nbv.experiments.compare",
     "compare_planners": "nbv.experiments.compare",
+    "OnlineConfig": "nbv.experiments.online",
+    "run_online": "nbv.experiments.online",
+    "PlannerStudy": "nbv.experiments.planner_study",
+    "run_study": "nbv.experiments.planner_study",
 }
 __all__ = sorted(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -198,15 +198,16 @@ def _quality(config: AblateConfig, rgbs, depths, poses, feats, K, picks, referen
 
 def _greedy_coverage(config: AblateConfig, unit: Unit, settings: RenderSettings) -> dict[str, float]:
     """Greedy Bag of Views planning at `greedy_views` views under `settings`: coverage of the true surface."""
-    from nbv.planning.plan import PlanConfig, plan_scan
+    from nbv.planning.config import PlanConfig, PlanSettings
+    from nbv.planning.plan import plan_scan
     from scenes.spec import SceneSpec
 
     with tempfile.TemporaryDirectory(prefix="nbv-ablate-") as tmp:
+        shared = PlanSettings(camera=config.camera, render=settings, candidates=config.greedy_candidates,
+                              full_scan=False, metrics=config.metrics, recon=config.recon)
         doc = plan_scan(PlanConfig(scene=SceneSpec(scene=unit.scene, up_axis=config.up_axis),
-                                   views=config.greedy_views, camera=config.camera, render=settings,
-                                   candidates=config.greedy_candidates, full_scan=False,
-                                   metrics=config.metrics, recon=config.recon, planner="greedy",
-                                   seed=unit.seed, out=Path(tmp) / "plan"))
+                                   views=config.greedy_views, planner="greedy", seed=unit.seed,
+                                   out=Path(tmp) / "plan", settings=shared))
     return {"greedy_coverage": doc["gt"]["coverage"], "greedy_deciding_s": doc["deciding_s"]}
 
 

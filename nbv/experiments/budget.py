@@ -4,45 +4,50 @@ A sequential planner's plan for the largest budget holds its shorter plans (each
 view depends only on the views before it): random, greedy, information gain and
 the policy plan once, at the largest budget, and every prefix is fused and
 scored. The circle spreads its views over the whole ring and the oracle swaps
-views to better the whole set, so they plan afresh at every budget. Runs are
-`nbv plan` folders scored against the ground truth only (no full scan), kept in
-a cache folder keyed by the settings and the commit (an interrupted run
-resumes; a new commit measures afresh). Each plan, then each plan's prefix
-scoring, is a unit of work (`nbv.fanout`), so `--workers` / `--ray` spread them.
+views to better the whole set, so they plan afresh at every budget (the
+registry's `prefixes`). The study is a `PlannerStudy` with `curves`
+(`nbv.experiments.planner_study`) under one nested `PlanSettings`: its runs are
+`nbv plan` folders, by default scored against the ground truth only (no full
+scan), kept in a cache folder keyed by the settings and the commit (an
+interrupted run resumes; a new commit measures afresh). Each plan, then each
+plan's prefix scoring, is a unit of work (`nbv.fanout`), so `--workers` /
+`--ray` spread them.
 The area under each curve is the mean coverage over the budget range
 (trapezoid rule, `coverage_auc`).
 """
 
 from __future__ import annotations
 
-import json
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
+from tyro.conf import arg
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import config_record, git_commit, run_cache
-from nbv.experiments.online import scene_folder
+from nbv.experiments.planner_study import PlannerStudy, StudyRun, run_study
 from nbv.fanout.config import ExecutorConfig
-from nbv.fanout.executor import run_stages
-from nbv.fanout.task import Task
-from nbv.planning.plan import PlanSettings, plan_scan
-from nbv.planning.planners import planner_label
-from nbv.recon.config import MetricsConfig, ReconstructionConfig
-from render.camera import UAVCamera
-from render.settings import RenderSettings
-from scenes.spec import SceneSpec
+from nbv.planning.config import PlanSettings
+from nbv.planning.registry import budget_planners, replanned
+from nbv.recon.config import MetricsConfig
+from nbv.viz.paper import plot_budget_curves
 
 BUDGETS = (5, 9, 13, 20)
 """View budgets of the curve (the paper's Fig. 1 count, 13, among them)."""
-PLANNERS = ("random", "circle", "greedy", "infogain", "policy", "oracle")
-"""Every planner of the harness (policy: the shipped one); the oracle is an upper bound."""
-REPLANNED = ("circle", "oracle")
+PLANNERS = budget_planners()
+"""Every planner of the harness (policy: the shipped one; the registry's `budget` entries at import: the
+config's default is read when it is made, so a planner registered later joins it); the oracle is an upper
+bound."""
+REPLANNED = tuple(name for name in replanned() if name in PLANNERS)
 """Planners whose shorter plans are not prefixes of their longer ones: planned at every budget."""
 OUTPUTS = ("budget.md", "budget.json", "budget.png")
 """What a budget study writes into its `out` together."""
+RUNS = "{scene}/{planner}-v{views}-seed{seed}"
+"""A budget run's folder in the study's cache folder."""
+SETTINGS = PlanSettings(full_scan=False, metrics=MetricsConfig(n_points=200_000))
+"""The plan settings of the budget curves: scored against the ground truth only, on 200k points."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -53,20 +58,15 @@ class BudgetConfig:
     """Folder for budget.{md,json,png}."""
     scenes: tuple[str, ...] = ("alpine_chalet", "imperial_temple")
     """Buildings (held out from training: nothing here tunes anything)."""
-    planners: tuple[str, ...] = PLANNERS
-    """Planners to compare (policy:CHECKPOINT for a policy other than the shipped one)."""
+    planners: tuple[str, ...] = field(default_factory=budget_planners)
+    """Planners to compare (the registry's budget planners; policy:CHECKPOINT for a policy other than the
+    shipped one)."""
     seeds: tuple[int, ...] = (0, 1, 2)
     """Seeds per planner and building."""
     budgets: tuple[int, ...] = BUDGETS
     """View budgets, ascending."""
-    camera: UAVCamera = UAVCamera()
-    """The camera of the captured views."""
-    render: RenderSettings = RenderSettings()
-    """How views are rendered."""
-    recon: ReconstructionConfig = ReconstructionConfig()
-    """TSDF fusion of every plan and prefix."""
-    metrics: MetricsConfig = MetricsConfig(n_points=200_000)
-    """How reconstructions are scored against the ground truth."""
+    settings: Annotated[PlanSettings, arg(name="")] = SETTINGS
+    """What every plan shares (`nbv plan`'s settings; fusion and scoring of every plan and prefix too)."""
     executor: ExecutorConfig = ExecutorConfig()
     """Where the runs run: this process, local workers or Ray (it changes no number)."""
 
@@ -75,6 +75,12 @@ class BudgetConfig:
             raise ValueError("a budget study needs at least one scene, planner, seed and budget")
         if list(self.budgets) != sorted(set(self.budgets)) or self.budgets[0] < 1:
             raise ValueError(f"budgets must be distinct, ascending and >= 1, got {self.budgets}")
+
+    def study(self, runs: Path) -> PlannerStudy:
+        """The budget curves as a planner study whose runs live in `runs` (`RUNS`)."""
+        return PlannerStudy(scenes=self.scenes, planners=self.planners, seeds=self.seeds,
+                            budgets=self.budgets, curves=True, settings=self.settings, out=runs, runs=RUNS,
+                            executor=self.executor)
 
 
 def coverage_auc(budgets: tuple[int, ...], coverage: list[float]) -> float:
@@ -91,94 +97,27 @@ def coverage_auc(budgets: tuple[int, ...], coverage: list[float]) -> float:
     return float(np.sum((c[1:] + c[:-1]) * np.diff(b)) / 2.0 / (b[-1] - b[0]))
 
 
-def plan_config(config: BudgetConfig, scene: str, planner: str, seed: int, views: int, folder: Path):
-    """The `nbv plan` run of one planner, seed and budget, into `folder`, scored against the truth only."""
-    settings = PlanSettings(scene=SceneSpec(scene=scene), views=views, camera=config.camera,
-                            render=config.render, full_scan=False, metrics=config.metrics, recon=config.recon)
-    return settings.plan_config(planner, seed, folder, overwrite=True)
-
-
-def score_run(folder: Path, views: tuple[int, ...], config: BudgetConfig, scene: str, seed: int) -> None:
-    """Write `folder/scores.json`: for each k in `views`, the coverage of the true surface by the first k
-    views of the run in `folder`, as reconstructed (TSDF, within the metric threshold; the run's own score
-    at its full length) and as seen (the oracle's measure: the share of true-surface samples some view
-    sees, `nbv.recon.visibility`)."""
-    from nbv.recon.metrics import evaluate_surfaces, load_geometry
-    from nbv.recon.tsdf import reconstruct_dataset
-    from nbv.recon.visibility import scene_visibility
-    from render.dataset import read_dataset
-    from render.viewpoint import Viewpoint, viewpoint_to_c2w
-
-    plan = json.loads((folder / "plan.json").read_text())
-    target = SceneSpec(scene=scene).load()
-    poses = [viewpoint_to_c2w(Viewpoint(*v), target.center()) for v in plan["viewpoints"]]
-    visibility = scene_visibility(target, config.camera, seed=seed)
-    dataset, gt = read_dataset(folder / "views"), load_geometry(folder / "gt.ply", "gt")
-    metrics, scores = replace(config.metrics, seed=seed), {}
-    for k in views:
-        if k == len(poses):
-            covered = plan["gt"]["coverage"]
-        else:
-            mesh = reconstruct_dataset(dataset, config.recon, range(k)).mesh
-            covered = evaluate_surfaces(mesh, {"gt": gt}, metrics)["gt"].coverage
-        scores[str(k)] = {"coverage": covered, "visible": visibility.coverage(poses[:k])}
-    write_json(folder / "scores.json", scores)
-
-
-def _folder(runs: Path, scene: str, planner: str, seed: int, views: int) -> Path:
-    return runs / scene_folder(scene) / f"{planner_label(planner)}-v{views}-seed{seed}"
-
-
-def budget_tasks(config: BudgetConfig, runs: Path) -> tuple[list[Task], list[Task]]:
-    """The study's units in two stages: every `nbv plan` run (replanned planners at every budget, the
-    others at the largest), then the scoring of each run at its budgets (a sequential plan's prefixes)."""
-    plans, scores = [], []
-    for scene in config.scenes:
-        for planner in config.planners:
-            for seed in config.seeds:
-                replanned = planner in REPLANNED
-                for views in (config.budgets if replanned else config.budgets[-1:]):
-                    folder = _folder(runs, scene, planner, seed, views)
-                    plans.append(Task(f"{folder.name} on {scene}", plan_scan,
-                                      {"config": plan_config(config, scene, planner, seed, views, folder)},
-                                      folder / "plan.json"))
-                    scores.append(Task(f"scores of {folder.name} on {scene}", score_run,
-                                       {"folder": folder, "views": (views,) if replanned else config.budgets,
-                                        "config": config, "scene": scene, "seed": seed},
-                                       folder / "scores.json"))
-    return plans, scores
-
-
-def planner_curve(config: BudgetConfig, scene: str, planner: str, seed: int, runs: Path,
-                  measure: str = "coverage") -> list[float]:
-    """One measure (`coverage` or `visible`, fractions) at each budget of one planner and seed on one
-    building, read back from its runs."""
-    def scores(views: int) -> dict[str, dict[str, float]]:
-        return json.loads((_folder(runs, scene, planner, seed, views) / "scores.json").read_text())
-
-    if planner in REPLANNED:
-        return [scores(b)[str(b)][measure] for b in config.budgets]
-    top = scores(config.budgets[-1])
-    return [top[str(b)][measure] for b in config.budgets]
-
-
 MEASURES = (("coverage", "Coverage (%) of the true surface by the TSDF reconstruction"),
             ("visible", "Visible coverage (%): true-surface samples some view sees (the oracle's measure)"))
 """The study's measures: (key in scores.json, what it is)."""
 
 
+def study_curves(runs: list[StudyRun], measure: str) -> dict[tuple[str, str], list[list[float]]]:
+    """One measure (`coverage` or `visible`) in % per building and planner label: a curve over the budgets
+    per seed, read back from the study's runs."""
+    curves: dict[tuple[str, str], dict[int, list[float]]] = {}
+    for run in runs:
+        seeds = curves.setdefault((run.scene, run.label), {})
+        seeds.setdefault(run.seed, []).append(100.0 * run.score(measure))
+    return {key: list(seeds.values()) for key, seeds in curves.items()}
+
+
 def run_budget(config: BudgetConfig) -> dict[str, list[dict[str, Any]]]:
     """Every planner's curves on every building and seed; writes budget.{md,json,png}; returns the rows per
     measure (building, planner, per-budget mean and std in %, AUC)."""
-    from nbv.viz.paper import plot_budget_curves
-
-    runs = run_cache("budget", config, unkeyed=("out", "scenes", "planners", "seeds", "executor"))
-    run_stages(budget_tasks(config, runs), config.executor)
-    curves = {measure: {(scene, planner_label(p)): [[100.0 * c for c in planner_curve(config, scene, p, seed,
-                                                                                     runs, measure)]
-                                                    for seed in config.seeds]
-                        for scene in config.scenes for p in config.planners}
-              for measure, _ in MEASURES}
+    cache = run_cache("budget", config, unkeyed=("out", "scenes", "planners", "seeds", "executor"))
+    runs = run_study(config.study(cache))
+    curves = {measure: study_curves(runs, measure) for measure, _ in MEASURES}
     rows = {measure: budget_rows(curves[measure], config.budgets) for measure, _ in MEASURES}
     record = config_record(config, omit=("executor",))
     with atomic_folder(config.out, overwrite=True, outputs=OUTPUTS) as out:
@@ -211,10 +150,10 @@ def budget_markdown(rows: dict[str, list[dict]], config: BudgetConfig) -> str:
     """The tables, one per measure: each planner at each budget (mean ± std) with the AUC."""
     lines = [f"# Coverage against view budget (commit {git_commit()})", "",
              f"Mean ± std over seeds {', '.join(map(str, config.seeds))} (the 'mean' rows: over buildings); "
-             f"coverage within {config.metrics.threshold_cm:g} cm. Sequential planners are scored on "
-             f"prefixes of their {config.budgets[-1]}-view plan; {', '.join(REPLANNED)} plan afresh at every "
-             "budget. AUC: mean over the budget range (trapezoid rule). The oracle uses the true mesh and "
-             "maximises visible coverage: an upper bound of that measure, not a planner a user has."]
+             f"coverage within {config.settings.metrics.threshold_cm:g} cm. Sequential planners are scored "
+             f"on prefixes of their {config.budgets[-1]}-view plan; {', '.join(REPLANNED)} plan afresh at "
+             "every budget. AUC: mean over the budget range (trapezoid rule). The oracle uses the true mesh "
+             "and maximises visible coverage: an upper bound of that measure, not a planner a user has."]
     for measure, title in MEASURES:
         body = [[r["scene"], r["planner"], *(f"{m:.1f} ± {s:.1f}" for m, s in zip(r["mean"], r["std"])),
                  f"{r['auc']:.1f}"] for r in rows[measure]]

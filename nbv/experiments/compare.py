@@ -1,9 +1,11 @@
 """`nbv compare`: planners over seeds on one (held-out) scene, beside the paper's Fig. 1.
 
-Every run is an `nbv plan` run (`nbv.planning.plan.plan_scan`) under the same
-shared settings; the table gives views, coverage, Chamfer and Hausdorff
-distances against the full-scan reference and the ground truth, mean +- std
-over seeds (docs/rl.md §10). Example (paper_results/planners):
+A `PlannerStudy` preset (`nbv.experiments.planner_study`: one building, one
+view budget): every run is an `nbv plan` run (`nbv.planning.plan.plan_scan`)
+under the same nested `PlanSettings`, so every `nbv plan` knob is a flag; the
+table gives views, coverage, Chamfer and Hausdorff distances against the
+full-scan reference and the ground truth, mean +- std over seeds (docs/rl.md
+§10). Example (paper_results/planners):
 
     nbv compare alpine_chalet --views 13 --planners policy:runs/policy/checkpoint.pt random circle greedy \\
         --seeds 0 1 2 --out cmp
@@ -20,46 +22,67 @@ the run folders carried over as hard links, so they always describe the same run
 
 from __future__ import annotations
 
-import json
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Annotated
 
 import numpy as np
+from tyro.conf import arg
 
 from common.io import atomic_folder, write_json, write_text
 from common.provenance import config_record, git_commit
 from nbv.experiments.paper_numbers import FIG1_NBV
+from nbv.experiments.planner_study import PlannerStudy, plan_units, reference_units, run_study
 from nbv.fanout.config import ExecutorConfig
-from nbv.fanout.executor import run_stages
 from nbv.fanout.task import Task
-from nbv.planning.plan import PlanSettings, plan_scan, reference_mesh
-from nbv.planning.planners import planner_label
+from nbv.planning.config import PlanSettings
+from nbv.planning.registry import entries, planner_specs
 from nbv.viz.figures import plot_planner_comparison
+from scenes.spec import SceneSpec
 
 OUTPUTS = ("comparison.json", "comparison.md", "comparison.png")
 """What `nbv compare` writes into `--out` together, beside the run folders."""
 
 
+def planners_help() -> str:
+    """The `--planners` help text, from the registry."""
+    bounds = ", ".join(e.name for e in entries() if e.reads_truth)
+    return f"Planners to compare: {planner_specs()} ({bounds}: an upper bound, it uses the true mesh)."
+
+
 @dataclass(frozen=True, kw_only=True)
-class CompareConfig(PlanSettings):
+class CompareConfig:
     """Settings of `nbv compare`: every `nbv plan` setting but the planner and seed, which it varies."""
 
-    planners: tuple[str, ...] = ("random", "circle", "greedy")
-    """Planners to compare: policy:CHECKPOINT, policy-sample:CHECKPOINT, random, circle, greedy,
-    hemisphere, infogain, oracle (an upper bound: it uses the true mesh)."""
+    scene: SceneSpec
+    """The target."""
+    views: int | None = None
+    """Number of views; default: the policy's episode, the whole hemisphere, or 13 (paper Fig. 1)."""
+    planners: Annotated[tuple[str, ...], arg(help=planners_help())] = ("random", "circle", "greedy")
     seeds: tuple[int, ...] = (0, 1, 2)
     """Seeds per planner."""
     out: Path
     """Folder of the runs (<planner label>-seed<seed>/, each an `nbv plan` output) and of
     comparison.{json,md,png}; runs already there are read back, not redone."""
+    settings: Annotated[PlanSettings, arg(name="")] = PlanSettings()
+    """What every run shares (`nbv plan`'s settings)."""
     executor: ExecutorConfig = ExecutorConfig()
     """Where the runs run: this process, local workers or Ray (not recorded: it changes no number)."""
 
     def __post_init__(self) -> None:
         if not self.planners or not self.seeds:
             raise ValueError("a comparison needs at least one planner and one seed")
-        if not self.full_scan:
+        if self.views is not None and self.views < 1:
+            raise ValueError(f"views must be >= 1 (or left out for the planner's default), got {self.views}")
+        if not self.settings.full_scan:
             raise ValueError("a comparison scores against the full scan too: leave out --no-full-scan")
+        self.study()  # an unknown planner fails here, naming every one
+
+    def study(self) -> PlannerStudy:
+        """The comparison as a planner study: one building, one budget, every run under `out`."""
+        return PlannerStudy(scenes=(self.scene.scene,), up_axis=self.scene.up_axis, planners=self.planners,
+                            seeds=self.seeds, budgets=(self.views,), settings=self.settings, out=self.out,
+                            executor=self.executor)
 
 
 COMPARED = (("coverage", "reference", 100.0, "coverage % (ref)"),
@@ -72,26 +95,11 @@ COMPARED = (("coverage", "reference", 100.0, "coverage % (ref)"),
 (`reference`); the same metrics against the ground-truth mesh (`gt`) follow."""
 
 
-def run_folder(config: CompareConfig, planner: str, seed: int) -> Path:
-    """The `nbv plan` output folder of one planner and seed: `out/<planner label>-seed<seed>`."""
-    return Path(config.out) / f"{planner_label(planner)}-seed{seed}"
-
-
 def comparison_tasks(config: CompareConfig) -> tuple[list[Task], list[Task]]:
     """The comparison's units, in two stages: making the full-scan reference (one unit, always run: it is
     cached), then one `plan_scan` per planner and seed, done once its `plan.json` exists."""
-    # The reference depends on neither the view count nor the planner: one unit per scene and settings.
-    shared = {f.name: getattr(config, f.name) for f in fields(PlanSettings) if f.name != "views"}
-    reference = Task(f"full-scan reference of {config.scene.scene}", reference_mesh,
-                     {"config": PlanSettings(**shared)})
-    runs = []
-    for planner in config.planners:
-        for seed in config.seeds:
-            folder = run_folder(config, planner, seed)
-            runs.append(Task(f"{folder.name} in {folder.parent}", plan_scan,
-                             {"config": config.plan_config(planner, seed, folder, overwrite=True)},
-                             folder / "plan.json"))
-    return [reference], runs
+    study = config.study()
+    return reference_units(study), plan_units(study)
 
 
 def compare_planners(config: CompareConfig) -> str:
@@ -100,20 +108,15 @@ def compare_planners(config: CompareConfig) -> str:
     Each run goes to `out/<label>-seed<seed>/` (`planner_label`); runs already there are read back.
     The table gives mean +- std over seeds beside the paper's Fig. 1 (13 views, SAC policy).
     """
-    out = Path(config.out)
-    reference, plans = comparison_tasks(config)
-    if not all(task.done() for task in plans):
-        run_stages([reference, plans], config.executor)
     runs = []
-    for planner in config.planners:
-        for seed in config.seeds:
-            doc = json.loads((run_folder(config, planner, seed) / "plan.json").read_text())
-            runs.append({"planner": planner_label(planner), "seed": seed,
-                         **{k: doc[k] for k in ("views", "gt", "reference", "planning_s", "deciding_s")}})
+    for run in run_study(config.study()):
+        doc = run.plan()
+        runs.append({"planner": run.label, "seed": run.seed,
+                     **{k: doc[k] for k in ("views", "gt", "reference", "planning_s", "deciding_s")}})
     scene = config.scene.scene
-    table = comparison_table(runs, scene, config.metrics.threshold_cm)
+    table = comparison_table(runs, scene, config.settings.metrics.threshold_cm)
     record = config_record(config, omit=("executor",))
-    with atomic_folder(out, overwrite=True, outputs=OUTPUTS) as folder:
+    with atomic_folder(Path(config.out), overwrite=True, outputs=OUTPUTS) as folder:
         write_text(folder / "comparison.md", table)
         plot_planner_comparison(runs, FIG1_NBV, folder / "comparison.png",
                                 f"Planners on {Path(scene).name}, {len(config.seeds)} seeds")

@@ -7,7 +7,9 @@ set against the full scan (Sec. VI-B), then a table and pictures: contact
 sheet, trajectories, distance heat maps. The online half (paper Sec. IV-VI-A)
 follows: the shipped policy plans one pass around a held-out building
 (`online_scene`), its views are captured, fused and scored against the ground
-truth beside random views at the same count (`nbv plan` runs, `online_*/`).
+truth beside random views at the same count (`nbv plan` runs, `online_*/`;
+two one-run planner studies, `online_study`, under the demo's camera,
+rendering, fusion and metric settings).
 
 Everything but the full scan (`OUTPUTS`) is written into one temporary folder and
 swapped onto `--out` at the end (`common.io.atomic_folder`), so an interrupted demo
@@ -33,8 +35,9 @@ from common.provenance import config_record, git_commit
 from nbv.bov.config import BoVConfig
 from nbv.bov.refine import Progress, RefineConfig, refine_dataset
 from nbv.experiments.paper_numbers import FIG7_GENERALISATION, FULL_SCAN_VIEWS, SEC7_SUMMARY, TABLE2
+from nbv.experiments.planner_study import PlannerStudy, run_study
 from nbv.experiments.study import FullScanStudy
-from nbv.planning.plan import PlanConfig, plan_scan
+from nbv.planning.config import PlanSettings
 from nbv.recon.heatmap import write_heatmap
 from nbv.recon.metrics import SurfaceMetrics, evaluate_surfaces
 from nbv.recon.tsdf import Reconstruction, reconstruct_dataset, save_reconstruction
@@ -42,7 +45,6 @@ from nbv.viz.figures import contact_sheet, plot_trajectory
 from render.dataset import ViewDataset, read_dataset
 from scenes.catalog import DEFAULT_SCENE
 from scenes.model import Scene
-from scenes.spec import SceneSpec
 
 OUTPUTS = ("refined", "recon_full", "recon_refined", "contact_sheet.png", "trajectory_full.png",
            "trajectory_refined.png", "heatmap_refined_vs_full.png", "heatmap_refined_vs_full.ply",
@@ -144,14 +146,22 @@ def demo_stages(config: DemoConfig, scene: Scene, full: ViewDataset, folder: Pat
     return results, results_table(results, metrics)
 
 
+def online_study(config: DemoConfig, folder: Path, name: str, planner: str,
+                 views: int | None) -> PlannerStudy:
+    """One run of the online half as a planner study: `planner` on `online_scene` at `views` (None: its
+    own count), into `folder/online_<name>`, under the demo's camera, rendering, fusion and metrics,
+    scored against the ground truth."""
+    settings = PlanSettings(camera=config.camera, render=config.render, recon=config.recon,
+                            metrics=config.metrics, full_scan=False)
+    return PlannerStudy(scenes=(config.online_scene,), up_axis=config.up_axis, planners=(planner,),
+                        seeds=(config.seed,), budgets=(views,), settings=settings, out=folder,
+                        runs=f"online_{name}")
+
+
 def online_half(config: DemoConfig, folder: Path) -> dict[str, dict[str, Any]]:
     """The policy's one pass around `online_scene`, then random views at its count: `nbv plan` runs."""
-    spec = SceneSpec(scene=config.online_scene, up_axis=config.up_axis)
-    shared = {"scene": spec, "camera": config.camera, "render": config.render, "recon": config.recon,
-              "metrics": config.metrics, "full_scan": False, "seed": config.seed, "overwrite": True}
-    policy = plan_scan(PlanConfig(**shared, planner=config.policy, out=folder / "online_policy"))
-    rand = plan_scan(PlanConfig(**shared, planner="random", views=policy["views"],
-                                out=folder / "online_random"))
+    policy = run_study(online_study(config, folder, "policy", config.policy, None))[0].plan()
+    rand = run_study(online_study(config, folder, "random", "random", policy["views"]))[0].plan()
     keep = ("views", "planning_s", "gt")
     return {"policy": {k: policy[k] for k in keep}, "random": {k: rand[k] for k in keep}}
 

@@ -11,9 +11,11 @@ and the policy's margins over random, circle and greedy Bag of Views with its pl
 over greedy (issue 11's acceptance figures), then the one-pass table. The buildings default to
 the held-out ones: nothing here trains or tunes anything.
 
-Every (planner, seed, building, protocol) run is an independent unit: all of them are handed to the
-executor at once (`--workers N`, `--ray auto|ADDRESS`; `nbv.fanout`), after each building's full-scan
-reference, so the buildings run side by side as well as the seeds.
+Every comparison is a `PlannerStudy` preset (`nbv.experiments.planner_study`) under the one nested
+`PlanSettings`, so every `nbv plan` knob is an `nbv online` flag. Every (planner, seed, building, protocol)
+run is an independent unit: all of them are handed to the executor at once (`--workers N`,
+`--ray auto|ADDRESS`; `nbv.fanout`), after each building's full-scan reference, so the buildings run side
+by side as well as the seeds.
 """
 
 from __future__ import annotations
@@ -21,19 +23,21 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Annotated
 
 import numpy as np
+from tyro.conf import arg
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import config_record, git_commit
-from nbv.experiments.compare import CompareConfig, compare_planners, comparison_tasks
+from nbv.experiments.compare import CompareConfig, compare_planners
 from nbv.experiments.paper_numbers import FIG1_NBV, FIG7_GENERALISATION
+from nbv.experiments.planner_study import run_studies, scene_folder
 from nbv.fanout.config import ExecutorConfig
-from nbv.fanout.executor import run_stages
-from nbv.planning.planners import planner_label
+from nbv.planning.config import PlanSettings
+from nbv.planning.registry import planner_label
 from nbv.recon.config import MetricsConfig
 from nbv.viz.figures import plot_seed_scores
-from render.settings import RenderSettings
 from scenes.spec import SceneSpec
 
 HELD_OUT = ("alpine_chalet", "imperial_temple", "random:0", "random:5", "random:10")
@@ -61,10 +65,9 @@ class OnlineConfig:
     """The fixed view budget."""
     one_pass: bool = True
     """Also run the paper's protocol: the first policy's own episode (one pass), against the full scan."""
-    render: RenderSettings = RenderSettings()
-    """How views are rendered (the Mitsuba variant included)."""
-    metrics: MetricsConfig = MetricsConfig(n_points=200_000)
-    """How reconstructions are scored (200k points per surface, as `nbv demo` and `nbv tables`)."""
+    settings: Annotated[PlanSettings, arg(name="")] = PlanSettings(metrics=MetricsConfig(n_points=200_000))
+    """What every run shares (`nbv plan`'s settings; reconstructions scored on 200k points per surface, as
+    `nbv demo` and `nbv tables`)."""
     executor: ExecutorConfig = ExecutorConfig()
     """Where the runs run: this process, local workers or Ray (not recorded: it changes no number)."""
 
@@ -75,17 +78,12 @@ class OnlineConfig:
             raise ValueError(f"views must be >= 1, got {self.views}")
 
 
-def scene_folder(scene: str) -> str:
-    """A file-name-safe folder name of a scene (random:5 -> random_5)."""
-    return Path(scene.replace(":", "_")).name
-
-
 def comparisons(config: OnlineConfig) -> list[CompareConfig]:
     """The `nbv compare` runs of the evaluation: per building, the fixed budget, then one pass if asked."""
     found = []
     for scene in config.scenes:
-        common = {"scene": SceneSpec(scene=scene), "render": config.render, "metrics": config.metrics,
-                  "seeds": config.seeds, "executor": config.executor}
+        common = {"scene": SceneSpec(scene=scene), "settings": config.settings, "seeds": config.seeds,
+                  "executor": config.executor}
         folder = Path(config.out) / scene_folder(scene)
         found.append(CompareConfig(**common, views=config.views, out=folder / f"views{config.views}",
                                    planners=(*config.policies, *config.baselines)))
@@ -98,10 +96,7 @@ def run_online(config: OnlineConfig) -> str:
     """Run (or read back) every comparison; write online.{md,json,png}; return the Markdown."""
     out = Path(config.out)
     compared = comparisons(config)
-    stages = [comparison_tasks(comparison) for comparison in compared]
-    if not all(task.done() for _, plans in stages for task in plans):
-        run_stages([[task for references, _ in stages for task in references],
-                    [task for _, plans in stages for task in plans]], config.executor)
+    run_studies([comparison.study() for comparison in compared], config.executor)
     budget, one_pass = {}, {}
     for comparison in compared:
         compare_planners(comparison)
@@ -160,7 +155,7 @@ def online_report(budget: dict[str, dict[str, list[dict]]], one_pass: dict[str, 
     deciding = {label: float(np.mean([r["deciding_s"] for runs in budget.values() for r in runs[label]]))
                 for label in labels}
     lines = [f"# Online NBV on held-out buildings (commit {git_commit()})", "",
-             f"Coverage (%) of the true surface within {config.metrics.threshold_cm:g} cm, "
+             f"Coverage (%) of the true surface within {config.settings.metrics.threshold_cm:g} cm, "
              f"{config.views} views, mean over seeds {', '.join(map(str, config.seeds))}; "
              "policies act on their mode.", "",
              f"Re-run: `{rerun_command(config)}`", "",

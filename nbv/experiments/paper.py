@@ -14,7 +14,7 @@ from __future__ import annotations
 import json
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Annotated, Any, Literal, NamedTuple
 
@@ -23,13 +23,16 @@ from tyro.conf import UseAppendAction
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import config_record, git_commit, run_cache
+from nbv.bov.config import BoVRule
 from nbv.bov.refine import Progress
-from nbv.experiments.budget import BUDGETS, PLANNERS, BudgetConfig, run_budget
+from nbv.experiments.budget import BUDGETS, SETTINGS, BudgetConfig, run_budget
 from nbv.experiments.compare import CompareConfig, compare_planners
-from nbv.experiments.online import scene_folder
 from nbv.experiments.paper_numbers import FIG1_NBV, FIG7_GENERALISATION, SEC7_SUMMARY
+from nbv.experiments.planner_study import scene_folder
 from nbv.experiments.table2 import TablesConfig, run_tables
-from nbv.recon.config import MetricsConfig
+from nbv.planning.config import PlanSettings
+from nbv.planning.registry import budget_planners
+from nbv.recon.config import MetricsConfig, OccupancyConfig
 from nbv.viz.paper import plot_episodes
 from render.camera import UAVCamera
 from render.scan import HemispherePlan
@@ -62,8 +65,13 @@ class PaperConfig(TablesConfig):
     """Seeds of the one-pass episodes (start view, renders, metric samples)."""
     budgets: tuple[int, ...] = BUDGETS
     """View budgets of the coverage curves (their seeds are `seeds`)."""
-    planners: tuple[str, ...] = PLANNERS
-    """Planners of the coverage curves (policy: the shipped one)."""
+    planners: tuple[str, ...] = field(default_factory=budget_planners)
+    """Planners of the coverage curves (the registry's budget planners; policy: the shipped one)."""
+    candidates: int = SETTINGS.candidates
+    """The coverage curves' greedy, oracle and infogain planners: candidate viewpoints per step (`nbv plan`'s
+    --candidates; their Bag of Views follows --match-cosine and the other rule flags)."""
+    occupancy: OccupancyConfig = SETTINGS.occupancy
+    """The coverage curves' infogain occupancy grid (`nbv plan`'s)."""
     quick: bool = False
     """A small run on the test building (one seed, 96x72): the defaults of `QUICK`."""
 
@@ -140,9 +148,10 @@ def run_episodes(config: PaperConfig) -> list[dict[str, Any]]:
     rows = []
     for scene, role in scenes:
         folder = runs / scene_folder(scene)
+        settings = PlanSettings(camera=config.camera, render=config.render, metrics=config.metrics,
+                                recon=config.recon)
         compare_planners(CompareConfig(scene=SceneSpec(scene=scene), planners=(config.policy,),
-                                       seeds=config.episode_seeds, camera=config.camera, render=config.render,
-                                       metrics=config.metrics, recon=config.recon, out=folder,
+                                       seeds=config.episode_seeds, settings=settings, out=folder,
                                        executor=config.executor))
         episodes = json.loads((folder / "comparison.json").read_text())["runs"]
         paper = FIG1_NBV if role.startswith("Fig. 1") else FIG7_GENERALISATION.get(scene, {})
@@ -197,12 +206,20 @@ def episodes_markdown(rows: list[dict[str, Any]], config: PaperConfig) -> str:
                         "coverage % (gt)"], body)])
 
 
+def budget_settings(config: PaperConfig) -> PlanSettings:
+    """The budget part's plan settings: the tables' camera, rendering, fusion and metrics, its Bag of Views
+    rule for the greedy planner's reward, its candidates and occupancy grid; the ground truth only."""
+    rule = {f.name: getattr(config.rule, f.name) for f in fields(BoVRule)}
+    return replace(SETTINGS, camera=config.camera, render=config.render, recon=config.recon,
+                   metrics=config.metrics, bov=replace(SETTINGS.bov, **rule), candidates=config.candidates,
+                   occupancy=config.occupancy)
+
+
 def budget_config(config: PaperConfig) -> BudgetConfig:
-    """The budget part's settings: the held-out buildings, the tables' seeds, camera, rendering, metrics."""
+    """The budget part's settings: the held-out buildings, the tables' seeds and plan settings."""
     return BudgetConfig(out=Path(config.out) / "budget", scenes=config.held_out,
                         planners=tuple(config.policy if p == "policy" else p for p in config.planners),
-                        seeds=config.seeds, budgets=config.budgets, camera=config.camera,
-                        render=config.render, recon=config.recon, metrics=config.metrics,
+                        seeds=config.seeds, budgets=config.budgets, settings=budget_settings(config),
                         executor=config.executor)
 
 

@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from nbv.rl.config import EnvConfig
-from nbv.rl.env import NBVEnv
 from render.viewpoint import Viewpoint
+
+if TYPE_CHECKING:
+    from nbv.planning.world import PlanningWorld
+    from nbv.rl.config import EnvConfig
 
 
 class Planner(ABC):
@@ -18,18 +21,23 @@ class Planner(ABC):
     """Short name used on the command line and in tables."""
 
     @abstractmethod
-    def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
+    def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """The viewpoints to capture, in order.
 
         Args:
-            env: a one-worker env on the target scene, freshly seeded.
+            world: the target, the allowed ranges, the camera, the view source and the start view.
             views: how many viewpoints; None for the planner's own count.
         """
 
+    def planning_env(self, own: EnvConfig) -> EnvConfig:
+        """The env settings it plans in, given the plan's own (`nbv.planning.plan.scan_env_config`): those
+        by default; a policy plans in its training settings."""
+        return own
 
-def sample_viewpoints(config: EnvConfig, count: int, rng: np.random.Generator) -> list[Viewpoint]:
-    """`count` viewpoints drawn uniformly in the config's ranges of R, azimuth and elevation."""
-    low, high = config.low, config.high
+
+def sample_viewpoints(low: np.ndarray, high: np.ndarray, count: int,
+                      rng: np.random.Generator) -> list[Viewpoint]:
+    """`count` viewpoints drawn uniformly between `low` and `high` (R, azimuth, elevation)."""
     return [Viewpoint(*map(float, low + rng.random(3) * (high - low))) for _ in range(count)]
 
 

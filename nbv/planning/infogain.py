@@ -1,6 +1,6 @@
 """Volumetric information gain: greedy on unknown voxels, model-free, from the depth of the views flown to.
 
-From the env's start view, each step draws K candidate viewpoints exactly as the
+From the start view, each step draws K candidate viewpoints exactly as the
 greedy Bag of Views planner does (`sample_viewpoints`, the same seeded stream)
 and moves to the one of highest gain in an occupancy grid
 (`nbv.recon.occupancy`): the number of unknown voxels its rays would reach, each
@@ -14,20 +14,26 @@ Robots 42, 2018); here with a ternary grid and hard visibility in place of
 their occupancy probabilities, and each voxel counted once per view. The grid covers the target's bounding box
 padded by a margin (the region of interest these methods are given; the env
 already aims every view at its centre) and is updated with the z-depth image the
-camera returns at each view flown to (`NBVEnv.render_depth`). Candidates are
-not rendered: their gain is ray cast through the grid. No appearance, no model.
+camera returns at each view flown to (`ViewSource.render_depth`). Candidates are
+not rendered: their gain is ray cast through the grid, and no RGB image is
+rendered at all. No appearance, no model.
 """
 
 from __future__ import annotations
+
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from nbv.planning.base import Planner, check_candidates, sample_viewpoints
 from nbv.recon.config import OccupancyConfig
 from nbv.recon.occupancy import OccupancyGrid
-from nbv.rl.env import NBVEnv
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes.model import Scene
+
+if TYPE_CHECKING:
+    from nbv.planning.config import PlanSettings
+    from nbv.planning.world import PlanningWorld
 
 
 def target_grid(scene: Scene, config: OccupancyConfig) -> OccupancyGrid:
@@ -57,20 +63,24 @@ class InfoGainPlanner(Planner):
         self.candidates = check_candidates("infogain", candidates)
         self.seed, self.grid, self.default_views = seed, grid, default_views
 
-    def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
+    def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """The start view, then `views - 1` moves, each to the candidate of highest gain."""
         rng = np.random.default_rng(self.seed)
-        env.reset()
-        scene, camera = env.scene, env.config.camera
+        scene, camera = world.target, world.camera
         grid, center = target_grid(scene, self.grid), scene.center()
-        view = env.viewpoint
+        view = world.start
         chosen = [view]
         for _ in range((self.default_views if views is None else views) - 1):
-            grid.integrate(env.render_depth(view), camera.K, viewpoint_to_c2w(view, center),
+            grid.integrate(world.source.render_depth(view), camera.K, viewpoint_to_c2w(view, center),
                            self.grid.integrate_ray_stride)
-            candidates = sample_viewpoints(env.config, self.candidates, rng)
+            candidates = sample_viewpoints(world.low, world.high, self.candidates, rng)
             gains = [grid.gain(camera.K, viewpoint_to_c2w(c, center), camera.width, camera.height,
                                self.grid.gain_ray_stride) for c in candidates]
             view = candidates[int(np.argmax(gains))]
             chosen.append(view)
         return chosen
+
+
+def infogain_planner(settings: PlanSettings, seed: int, checkpoint: str | None) -> InfoGainPlanner:
+    """The registry's `infogain`: K = `settings.candidates`, the grid of `settings.occupancy`."""
+    return InfoGainPlanner(settings.candidates, seed, settings.occupancy)

@@ -1,6 +1,6 @@
 """The coverage oracle: greedy on the true surface, an upper-bound reference that uses the model.
 
-Candidates (the pool): the env's start view; the K random viewpoints per step
+Candidates (the pool): the start view; the K random viewpoints per step
 that the greedy Bag of Views planner is offered (`sample_viewpoints`, the same
 seeded stream, all steps' at once); and a fixed lattice over the allowed ranges
 (`POOL`, 756 viewpoints, the middle ring among them). The oracle picks `views`
@@ -18,7 +18,7 @@ elsewhere (random, circle) too.
 Seen means `nbv.recon.visibility`: the target mesh is sampled once per plan
 (area-uniform, the planner's seed) and a sample counts as seen by a view when it
 is in frame and no part of the scene (ground included) hides it, by ray casting
-the true meshes. Nothing is rendered but the start view (the env's reset).
+the true meshes. Nothing is rendered.
 
 It reads the ground-truth mesh, which no real planner has: it is a reference
 for what a planner could reach, labelled as an upper bound in tables and docs.
@@ -31,15 +31,20 @@ planners do not beat it there.
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from nbv.planning.base import Planner, check_candidates, sample_viewpoints
 from nbv.recon.visibility import scene_visibility
-from nbv.rl.config import EnvConfig, LatticeConfig
-from nbv.rl.env import NBVEnv
+from nbv.rl.config import LatticeConfig
 from nbv.rl.lattice import lattice_axes
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
+
+if TYPE_CHECKING:
+    from nbv.planning.config import PlanSettings
+    from nbv.planning.world import PlanningWorld
+    from nbv.rl.config import EnvConfig
 
 POOL = LatticeConfig(lattice_radii=3, lattice_azimuths=36, lattice_elevations=7)
 """The oracle's fixed candidates: a lattice over the allowed ranges whose odd counts hold the middle
@@ -76,16 +81,15 @@ class CoverageOraclePlanner(Planner):
         self.seed, self.pool, self.starts, self.default_views = seed, pool, starts, default_views
         self.points, self.tolerance_m = points, tolerance_m
 
-    def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
+    def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """`views` viewpoints of the pool that together see the most surface samples, in greedy order."""
         count = self.default_views if views is None else views
         rng = np.random.default_rng(self.seed)
-        env.reset()
-        scene = env.scene
-        visibility = scene_visibility(scene, env.config.camera, self.points, self.tolerance_m, self.seed)
+        scene = world.target
+        visibility = scene_visibility(scene, world.camera, self.points, self.tolerance_m, self.seed)
         center = scene.center()
-        pool = [env.viewpoint, *sample_viewpoints(env.config, self.candidates * (count - 1), rng),
-                *lattice_viewpoints(env.config, self.pool)]
+        pool = [world.start, *sample_viewpoints(world.low, world.high, self.candidates * (count - 1), rng),
+                *lattice_viewpoints(world.env, self.pool)]
         seen = np.packbits([visibility.seen(viewpoint_to_c2w(view, center)) for view in pool], axis=1)
         singles = ones(seen)
         starts = dict.fromkeys([0, *np.argsort(-singles, kind="stable")[:self.starts - 1].tolist()])
@@ -139,3 +143,8 @@ def improve_by_swaps(chosen: list[int], seen: np.ndarray, passes: int = 5) -> li
         if not swapped:
             break
     return chosen
+
+
+def oracle_planner(settings: PlanSettings, seed: int, checkpoint: str | None) -> CoverageOraclePlanner:
+    """The registry's `oracle`: K = `settings.candidates` random candidates per step in its pool."""
+    return CoverageOraclePlanner(settings.candidates, seed)

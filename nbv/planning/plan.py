@@ -1,6 +1,6 @@
 """`nbv plan`: plan a scan with one planner, capture it, reconstruct it, score it.
 
-Stages, each a verb: `choose_views` (the planner, on a one-worker env),
+Stages, each a verb: `choose_views` (the planner, in a `PlanningWorld`),
 `capture_dataset` (RGB-D views on disk), `reconstruct_dataset` (TSDF fusion),
 `evaluate` (`nbv evaluate`'s function, so `metrics.json` has its format)
 against the ground-truth mesh (`gt`) and against the full-scan reconstruction
@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import json
 import time
-from dataclasses import dataclass, fields, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -24,21 +24,19 @@ import numpy as np
 from common.io import atomic_folder, check_output_folder, write_json
 from common.provenance import config_record, run_record
 from common.threads import chosen_threads, limit_torch_threads, worker_threads
-from nbv.bov.config import BoVConfig
-from nbv.planning.planners import Planner, PolicyPlanner, make_planner
-from nbv.recon.config import MetricsConfig, OccupancyConfig, ReconstructionConfig
+from nbv.planning.base import Planner
+from nbv.planning.config import PlanConfig, PlanSettings
+from nbv.planning.registry import make_planner
+from nbv.planning.world import PlanningWorld
 from nbv.recon.evaluate import EvaluateConfig, GroundTruth, write_evaluation
 from nbv.recon.metrics import load_geometry
 from nbv.recon.tsdf import reconstruct_dataset, save_reconstruction
-from nbv.rl.config import EnvConfig, LatticeConfig
-from nbv.rl.env import NBVEnv
+from nbv.rl.config import EnvConfig
 from nbv.viz.figures import plot_trajectory
-from render.camera import UAVCamera
 from render.capture import capture_dataset
 from render.dataset import read_dataset
 from render.scan import HemispherePlan
 from render.scan_cache import full_scan
-from render.settings import RenderSettings
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes.model import Scene
 from scenes.spec import SceneSet, SceneSpec
@@ -47,81 +45,16 @@ RECONSTRUCTION_KEY = "reconstruction.json"
 """The settings a cached reference reconstruction was fused with, beside its mesh."""
 
 
-@dataclass(frozen=True, kw_only=True)
-class PlanSettings:
-    """What every planned scan of one target shares: camera, rendering, Bag of Views, fusion, scoring."""
-
-    scene: SceneSpec
-    """The target."""
-    views: int | None = None
-    """Number of views; default: the policy's episode, the whole hemisphere, or 13 (paper Fig. 1)."""
-    camera: UAVCamera = UAVCamera()
-    """The camera of the captured views (a policy plans at its training resolution)."""
-    render: RenderSettings = RenderSettings()
-    """How views are rendered."""
-    bov: BoVConfig = BoVConfig(ranges=8)
-    """The Bag of Views of the greedy planner's reward (a policy keeps its training one)."""
-    candidates: int = 8
-    """Greedy, oracle and infogain planners: candidate viewpoints per step (only greedy renders them)."""
-    occupancy: OccupancyConfig = OccupancyConfig()
-    """The infogain planner's occupancy grid."""
-    reference: Path | None = None
-    """Reference mesh (full-scan reconstruction); default: reconstruct the hemisphere scan, cached."""
-    full_scan: bool = True
-    """Also score against the full scan's reconstruction (`reference`); off: against the ground truth only
-    (no hemisphere scan to render)."""
-    metrics: MetricsConfig = MetricsConfig()
-    """How the reconstruction is scored."""
-    recon: ReconstructionConfig = ReconstructionConfig()
-    """TSDF fusion of the captured views (and of the reference scan)."""
-
-    def __post_init__(self) -> None:
-        if self.views is not None and self.views < 1:
-            raise ValueError(f"views must be >= 1 (or left out for the planner's default), got {self.views}")
-
-    def plan_config(self, planner: str, seed: int, out: Path, overwrite: bool = False) -> PlanConfig:
-        """The `nbv plan` run of one planner and seed under these settings."""
-        shared = {f.name: getattr(self, f.name) for f in fields(PlanSettings)}
-        return PlanConfig(**shared, planner=planner, seed=seed, out=out, overwrite=overwrite)
-
-
-@dataclass(frozen=True, kw_only=True)
-class PlanConfig(PlanSettings):
-    """Settings of `nbv plan`."""
-
-    planner: str = "random"
-    """random, circle, greedy, hemisphere, infogain (volumetric information gain, from depth), oracle (greedy
-    on the true surface: an upper bound, it uses the model), policy:CHECKPOINT (a `nbv train` checkpoint.pt,
-    its mode) or policy-sample:CHECKPOINT (seeded draws from the policy)."""
-    out: Path
-    """Output folder: views/, mesh.ply, points.ply, gt.ply, metrics.json, heatmap.*, trajectory.png,
-    plan.json."""
-    seed: int = 0
-    """Seed of the planner, the start view, the renders and the metrics' sampling."""
-    overwrite: bool = False
-    """Replace a non-empty output folder."""
-
-
-def scan_env_config(config: PlanSettings) -> EnvConfig:
+def scan_env_config(scene: SceneSpec, settings: PlanSettings) -> EnvConfig:
     """The plan's own env: its scene, camera, rendering and Bag of Views, the default viewpoint ranges."""
-    scenes = SceneSet(scene=(config.scene.scene,), up_axis=config.scene.up_axis)
-    return EnvConfig(scenes=scenes, camera=config.camera, render=config.render, bov=config.bov)
+    scenes = SceneSet(scene=(scene.scene,), up_axis=scene.up_axis)
+    return EnvConfig(scenes=scenes, camera=settings.camera, render=settings.render, bov=settings.bov)
 
 
 def planning_env_config(config: PlanConfig, planner: Planner) -> EnvConfig:
-    """The env the planner works in: a policy's training settings on this scene, else `scan_env_config`.
-
-    Planning always renders exact viewpoints: a policy trained on a view lattice plans without it. Its
-    episode ends where the protocol says (one pass, or the view budget), whatever budget it trained with,
-    and no reward reads the true mesh.
-    """
-    own = scan_env_config(config)
-    if isinstance(planner, PolicyPlanner):
-        trained = planner.env_config
-        render = replace(trained.render, variant=config.render.variant)
-        return replace(trained, scenes=own.scenes, render=render, lattice=LatticeConfig(), episode_views=0,
-                       coverage_reward=0.0)
-    return own
+    """The env settings the planner works in: the ones it declares (`Planner.planning_env`) given the
+    plan's own, `scan_env_config` (a policy: its training settings on this scene, exact renders)."""
+    return planner.planning_env(scan_env_config(config.scene, config.settings))
 
 
 def choose_views(config: PlanConfig, planner: Planner,
@@ -135,14 +68,15 @@ def choose_views(config: PlanConfig, planner: Planner,
     Torch runs on the thread policy's count (`common.threads.worker_threads`, 1) while planning, unless
     this process already chose its threads; the previous count is restored afterwards.
     """
-    env = NBVEnv(env_config, seed=config.seed)
+    world = PlanningWorld(env_config, seed=config.seed)
     threads = 0 if chosen_threads() is not None else worker_threads()
     with limit_torch_threads(threads):
         start = time.perf_counter()
-        views = planner.plan(env, config.views)
+        views = planner.plan(world, config.views)
         seconds = time.perf_counter() - start
-    camera = (env.setup_seconds + flown_seconds(env.render_seconds, env.views_rendered, len(views))
-              + flown_seconds(env.depth_seconds, env.depths_rendered, len(views)))
+    clock = world.source
+    camera = (clock.setup_seconds + flown_seconds(clock.render_seconds, clock.views_rendered, len(views))
+              + flown_seconds(clock.depth_seconds, clock.depths_rendered, len(views)))
     return views, seconds, min(camera, seconds)
 
 
@@ -152,7 +86,7 @@ def flown_seconds(seconds: float, rendered: int, flown: int) -> float:
     return seconds / rendered * min(rendered, flown) if rendered else 0.0
 
 
-def reference_mesh(config: PlanSettings, scene: Scene | None = None) -> Path:
+def reference_mesh(scene: SceneSpec, settings: PlanSettings, loaded: Scene | None = None) -> Path:
     """The full hemisphere scan's reconstruction (paper Sec. V-B), cached inside the cached scan's folder.
 
     The scan comes from `render.scan_cache.full_scan`, re-rendered only when the scene, camera or
@@ -160,16 +94,16 @@ def reference_mesh(config: PlanSettings, scene: Scene | None = None) -> Path:
     reconstruction is redone when its settings (`RECONSTRUCTION_KEY`) change. The scan renders at the
     plan's render settings with their own seed, not the run's: every seed is scored against one reference.
     """
-    if config.reference is not None:
-        return Path(config.reference)
-    env_config = scan_env_config(config)
+    if settings.reference is not None:
+        return Path(settings.reference)
+    env_config = scan_env_config(scene, settings)
     radius = (env_config.radius_min + env_config.radius_max) / 2.0
-    full = full_scan(scene or config.scene.load(), config.camera, settings=config.render,
+    full = full_scan(loaded or scene.load(), settings.camera, settings=settings.render,
                      plan=HemispherePlan(radius=radius), progress=False)
-    folder = full.root / f"reconstruction_{config.recon.voxel_size_m * 1000:g}mm"
-    key = config_record(config.recon)
+    folder = full.root / f"reconstruction_{settings.recon.voxel_size_m * 1000:g}mm"
+    key = config_record(settings.recon)
     if not (folder / "mesh.ply").is_file() or _stored(folder / RECONSTRUCTION_KEY) != key:
-        recon = reconstruct_dataset(full, config.recon)
+        recon = reconstruct_dataset(full, settings.recon)
         with atomic_folder(folder, overwrite=True) as tmp:
             save_reconstruction(recon, tmp)
             write_json(tmp / RECONSTRUCTION_KEY, key)
@@ -187,21 +121,22 @@ def plan_scan(config: PlanConfig) -> dict:
     """
     out = Path(config.out)
     check_output_folder(out, config.overwrite)
-    planner = make_planner(config.planner, config.seed, config.candidates, config.occupancy)
+    shared = config.settings
+    planner = make_planner(config.planner, shared, config.seed)
     views, plan_s, camera_s = choose_views(config, planner, planning_env_config(config, planner))
     scene = config.scene.load()
-    settings = replace(config.render, seed=config.seed)
+    settings = replace(shared.render, seed=config.seed)
     meta = {"planner": config.planner, "up_axis": config.scene.up_axis}
     with atomic_folder(out, config.overwrite) as folder:
-        dataset = capture_dataset(scene, config.camera, views, folder / "views", settings,
+        dataset = capture_dataset(scene, shared.camera, views, folder / "views", settings,
                                   meta, overwrite=True, progress=False)
-        recon = reconstruct_dataset(read_dataset(dataset), config.recon)
+        recon = reconstruct_dataset(read_dataset(dataset), shared.recon)
         save_reconstruction(recon, folder)
         scene.target_mesh().export(folder / "gt.ply")
-        reference = reference_mesh(config, scene) if config.full_scan else None
+        reference = reference_mesh(config.scene, shared, scene) if shared.full_scan else None
         gt = GroundTruth(gt=str(out / "gt.ply"))  # the normalised target: z up whatever the scene file's axis
         evaluation = EvaluateConfig(mesh=out / "mesh.ply", reference=reference, ground_truth=gt, out=out,
-                                    metrics=config.metrics, seed=config.seed, overwrite=True)
+                                    metrics=shared.metrics, seed=config.seed, overwrite=True)
         references = {"gt": load_geometry(folder / "gt.ply", "gt")}
         if reference is not None:
             references["reference"] = load_geometry(reference, "reference")

@@ -1,16 +1,18 @@
 """View planners behind one interface: the trained policy and the baselines (docs/rl.md).
 
-`Planner.plan(env, views)` returns the viewpoints to capture, in order. The
-env (a one-worker `NBVEnv` on the target scene) supplies the allowed ranges,
-the start viewpoint, rendering, features and the Bag of Views; the planners
-that need no images (random, circle, hemisphere) use only its config. The
-interface and the candidate scheme of the greedy planners are in `base.py`.
+`Planner.plan(world, views)` returns the viewpoints to capture, in order. The
+world (`world.py`) supplies the allowed ranges, the camera, the start
+viewpoint, the view source (rendering, features) and a Bag of Views; the
+planners that need no images (random, circle, hemisphere) use only the ranges
+and the camera. The
+interface and the candidate scheme of the greedy planners are in `base.py`; the
+planners by name in `registry.py`.
 
 - `RandomPlanner`: viewpoints drawn uniformly in the allowed ranges.
 - `CirclePlanner`: evenly spaced azimuths at the middle radius and elevation.
-- `GreedyBoVPlanner`: from the env's start view, at each step render K
+- `GreedyBoVPlanner`: from the start view, at each step render K
   candidate viewpoints drawn uniformly in the ranges and move to the one of
-  highest Bag of Views reward (Sec. IV's reward under the env's `bov` config, no learning).
+  highest Bag of Views reward (Sec. IV's reward under the plan's `bov` config, no learning).
 - `HemispherePlanner`: the full-coverage hemisphere scan (Sec. V-B), the
   paper's reference.
 - `InfoGainPlanner` (`infogain.py`): greedy on volumetric information gain,
@@ -20,7 +22,7 @@ interface and the candidate scheme of the greedy planners are in `base.py`.
   true surface among greedy's candidates and a fixed lattice (greedy with
   restarts, then swaps); it uses the ground-truth mesh, so it is an upper-bound
   reference, not a planner a real UAV could run.
-- `PolicyPlanner`: a trained SAC actor from the env's start view, acting on
+- `PolicyPlanner` (`policy.py`): a trained SAC actor from the start view, acting on
   its distribution's mode (`policy:CHECKPOINT`, deterministic) or on seeded
   draws from it (`policy-sample:CHECKPOINT`, the max-entropy policy SAC
   trained, whose action dimensions the reward does not constrain stay spread).
@@ -28,24 +30,18 @@ interface and the candidate scheme of the greedy planners are in `base.py`.
 
 from __future__ import annotations
 
-import copy
 import math
-from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from common.provenance import config_from_record
 from nbv.planning.base import Planner, check_candidates, sample_viewpoints
-from nbv.planning.infogain import InfoGainPlanner
-from nbv.planning.oracle import CoverageOraclePlanner
-from nbv.recon.config import OccupancyConfig
-from nbv.rl.agent import make_actor
-from nbv.rl.checkpoint import CheckpointError, load_policy
-from nbv.rl.config import EnvConfig, NetworkConfig
-from nbv.rl.env import NBVEnv
-from nbv.rl.rollout import policy_views
 from render.scan import HemispherePlan, hemisphere_scan
 from render.viewpoint import TWO_PI, Viewpoint
+
+if TYPE_CHECKING:
+    from nbv.planning.config import PlanSettings
+    from nbv.planning.world import PlanningWorld
 
 
 class RandomPlanner(Planner):
@@ -56,10 +52,10 @@ class RandomPlanner(Planner):
     def __init__(self, seed: int = 0, default_views: int = 13) -> None:
         self.seed, self.default_views = seed, default_views
 
-    def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
+    def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """`views` (default 13, the paper's Fig. 1 count) random viewpoints."""
         count = self.default_views if views is None else views
-        return sample_viewpoints(env.config, count, np.random.default_rng(self.seed))
+        return sample_viewpoints(world.low, world.high, count, np.random.default_rng(self.seed))
 
 
 class CirclePlanner(Planner):
@@ -70,10 +66,10 @@ class CirclePlanner(Planner):
     def __init__(self, default_views: int = 13) -> None:
         self.default_views = default_views
 
-    def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
+    def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """`views` (default 13) viewpoints on one ring."""
         count = self.default_views if views is None else views
-        mid = (env.config.low + env.config.high) / 2.0
+        mid = (world.low + world.high) / 2.0
         return [Viewpoint(float(mid[0]), TWO_PI * k / count, float(mid[2])) for k in range(count)]
 
 
@@ -82,10 +78,10 @@ class HemispherePlanner(Planner):
 
     name = "hemisphere"
 
-    def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
+    def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """Every viewpoint of the scan (`views`, if given, must not be smaller than it)."""
-        radius = (env.config.radius_min + env.config.radius_max) / 2.0
-        scan = hemisphere_scan(env.config.camera, HemispherePlan(radius=radius))
+        radius = (world.env.radius_min + world.env.radius_max) / 2.0
+        scan = hemisphere_scan(world.camera, HemispherePlan(radius=radius))
         if views is not None and views < len(scan):
             raise ValueError(f"the hemisphere scan has {len(scan)} views; --views {views} would cut it")
         return scan
@@ -100,102 +96,39 @@ class GreedyBoVPlanner(Planner):
         self.candidates = check_candidates("greedy", candidates)
         self.seed, self.default_views = seed, default_views
 
-    def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
+    def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """The start view, then `views - 1` greedy moves (default 13 views in all)."""
         rng = np.random.default_rng(self.seed)
-        env.reset()
-        chosen = [env.viewpoint]
+        source, bov, start = world.source, world.bov, world.start
+        bov.update(source.capture(start)[1], start.azimuth, start.elevation)  # as the env learns its first
+        chosen = [start]
         for _ in range((self.default_views if views is None else views) - 1):
             best, best_reward, best_descriptors = None, -math.inf, None
-            for view in sample_viewpoints(env.config, self.candidates, rng):
-                _, descriptors = env.capture(view)
-                reward = copy.deepcopy(env.bov).reward(descriptors, view.azimuth, view.elevation)
+            for view in sample_viewpoints(world.low, world.high, self.candidates, rng):
+                _, descriptors = source.capture(view)
+                reward = bov.reward(descriptors, view.azimuth, view.elevation, commit=False)
                 if reward > best_reward:
                     best, best_reward, best_descriptors = view, reward, descriptors
-            env.bov.update(best_descriptors, best.azimuth, best.elevation)
+            bov.update(best_descriptors, best.azimuth, best.elevation)
             chosen.append(best)
         return chosen
 
 
-class PolicyPlanner(Planner):
-    """A trained SAC policy from the env's start view: its distribution's mode, or seeded draws from it."""
-
-    name = "policy"
-
-    def __init__(self, checkpoint: str | Path, sample: bool = False, seed: int = 0) -> None:
-        self.sample, self.seed = sample, seed
-        config, weights = load_policy(checkpoint)
-        try:
-            self.env_config = config_from_record(EnvConfig, config["env"])
-            network = config_from_record(NetworkConfig, config["network"])
-            self.actor = make_actor(self.env_config.history, self.env_config.obs_size, network)
-        except (KeyError, TypeError, ValueError, AttributeError, RuntimeError) as err:
-            raise CheckpointError(f"checkpoint {checkpoint}: its config does not fit this toolkit: "
-                                  f"{type(err).__name__}: {err}") from err
-        try:
-            self.actor.load_state_dict(weights)
-        except (AttributeError, TypeError, RuntimeError) as err:
-            raise CheckpointError(f"checkpoint {checkpoint}: actor weights do not fit: {err}") from err
-        self.actor.eval()
-
-    def check_env(self, env: NBVEnv) -> None:
-        """Refuse an env whose state or action differs from the one the policy was trained on."""
-        for key in ("history", "obs_size", "radius_min", "radius_max", "elevation_min_deg",
-                    "elevation_max_deg", "action_mode", "relative_step"):
-            trained, now = getattr(self.env_config, key), getattr(env.config, key)
-            if now != trained:
-                raise ValueError(f"the policy was trained with {key}={trained!r}, the env has {now!r}")
-
-    def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
-        """Act until the episode ends (one pass or the step cap), or for exactly `views` views."""
-        self.check_env(env)
-        return policy_views(self.actor, env, views, self.sample, self.seed)
+def random_planner(settings: PlanSettings, seed: int, checkpoint: str | None) -> RandomPlanner:
+    """The registry's `random`."""
+    return RandomPlanner(seed)
 
 
-POLICY_KINDS = ("policy", "policy-sample")
-"""Spec prefixes of a trained policy: acting on its mode, or on seeded draws."""
-SHIPPED_POLICY = Path(__file__).with_name("shipped") / "policy.pt"
-"""The policy of the default `nbv train` command, shipped with the toolkit (its config, metrics log and
-learning curves beside it): what `policy` and `policy-sample` without a checkpoint use."""
+def circle_planner(settings: PlanSettings, seed: int, checkpoint: str | None) -> CirclePlanner:
+    """The registry's `circle`."""
+    return CirclePlanner()
 
 
-def split_policy_spec(spec: str) -> tuple[str, str] | None:
-    """(kind, checkpoint) of a `policy[:CHECKPOINT]` or `policy-sample[:CHECKPOINT]` spec (no checkpoint:
-    the shipped policy); None for a baseline."""
-    kind, sep, checkpoint = spec.partition(":")
-    if kind not in POLICY_KINDS:
-        return None
-    return kind, checkpoint if sep else str(SHIPPED_POLICY)
+def hemisphere_planner(settings: PlanSettings, seed: int, checkpoint: str | None) -> HemispherePlanner:
+    """The registry's `hemisphere`."""
+    return HemispherePlanner()
 
 
-def make_planner(spec: str, seed: int = 0, candidates: int = 8,
-                 occupancy: OccupancyConfig = OccupancyConfig()) -> Planner:
-    """A planner by name: random, circle, greedy, hemisphere, infogain, oracle, policy[:CHECKPOINT],
-    policy-sample[:CHECKPOINT] (a training checkpoint.pt or a policy.pt; without one, the shipped policy).
-
-    `candidates` is K of greedy, infogain and oracle; `occupancy` is infogain's grid."""
-    if policy := split_policy_spec(spec):
-        kind, checkpoint = policy
-        return PolicyPlanner(checkpoint, sample=kind == "policy-sample", seed=seed)
-    if spec == "random":
-        return RandomPlanner(seed)
-    if spec == "circle":
-        return CirclePlanner()
-    if spec == "greedy":
-        return GreedyBoVPlanner(candidates, seed)
-    if spec == "hemisphere":
-        return HemispherePlanner()
-    if spec == "infogain":
-        return InfoGainPlanner(candidates, seed, occupancy)
-    if spec == "oracle":
-        return CoverageOraclePlanner(candidates, seed)
-    raise ValueError(f"unknown planner {spec!r}; use random, circle, greedy, hemisphere, infogain, oracle, "
-                     "policy:CHECKPOINT or policy-sample:CHECKPOINT")
-
-
-def planner_label(spec: str) -> str:
-    """A short, file-name-safe label of a planner spec: a policy is named after its run folder."""
-    if policy := split_policy_spec(spec):
-        kind, checkpoint = policy
-        return f"{kind}-{Path(checkpoint).resolve().parent.name}"  # the shipped one: policy-shipped
-    return spec
+def greedy_planner(settings: PlanSettings, seed: int, checkpoint: str | None) -> GreedyBoVPlanner:
+    """The registry's `greedy`: K = `settings.candidates`."""
+    return GreedyBoVPlanner(settings.candidates, seed)

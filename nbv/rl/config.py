@@ -14,12 +14,12 @@ Training-only reward terms, which read the true mesh, are `TrainConfig`'s
 from __future__ import annotations
 
 import math
-from dataclasses import InitVar, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
-from tyro.conf import Suppress, arg
+from tyro.conf import arg
 
 from common.threads import WORKER_THREADS
 from nbv.bov.config import BoVConfig
@@ -89,15 +89,8 @@ class EnvConfig:
     relative_step: float = 0.25
     """Relative and orbit modes: the largest step per action, as a fraction of each range (azimuth: of
     2 pi)."""
-    coverage_reward: InitVar[Annotated[float, Suppress]] = 0.0
-    """Not a setting (no flag, not recorded): kept, 0 only, while `nbv/planning/plan.py` still passes
-    `coverage_reward=0.0`; delete once it calls `nbv.rl.validate.evaluation_env_config`. The coverage
-    term is `TrainConfig.reward`'s."""
 
-    def __post_init__(self, coverage_reward: float = 0.0) -> None:
-        if coverage_reward:
-            raise ValueError("the coverage reward is a training-only term, not an env setting: "
-                             "TrainConfig.reward.coverage (--coverage-reward) gives it to the training env")
+    def __post_init__(self) -> None:
         if not 0 < self.radius_min <= self.radius_max:
             raise ValueError(f"need 0 < radius_min <= radius_max, got {self.radius_min}, {self.radius_max}")
         check_camera_distance("radius_min", self.radius_min, self.camera)

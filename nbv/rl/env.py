@@ -41,13 +41,14 @@ kept relative steps smaller than half a node spacing from ever moving the
 camera (R never changed, elevation only at |action| > 0.8), so policies
 trained that way flew one ring at their start elevation.
 
-Rendering: one renderer per scene (loaded with the scene set's up axis),
-created lazily on the first reset, in the process that steps the env, so
-`ParallelEnv`'s spawned workers each choose their own Mitsuba variant; view k
-is rendered with the config's render settings' `view_seed(k)` under the env's
-seed. `render_depth` gives the z-depth a depth camera returns at a view
-(the information-gain planner's input), timed apart from the RGB renders.
-The constructor takes only picklable settings. Before the first view is
+Rendering: through a view source (`nbv.features.source.ViewSource`, the one
+the planners and the validator use too): one renderer per scene (loaded with
+the scene set's up axis), created lazily on the first reset, in the process
+that steps the env, so `ParallelEnv`'s spawned workers each choose their own
+Mitsuba variant; view k is rendered with the config's render settings'
+`view_seed(k)` under the env's seed. `render_depth` gives the z-depth a depth
+camera returns at a view, timed apart from the RGB renders. The constructor
+takes only picklable settings (or a view source to share). Before the first view is
 rendered the process's torch threads follow the thread policy
 (`common.threads.apply_thread_policy`: 1 unless the process chose otherwise),
 since the renderer and Kornia SIFT share the cores with everything else.
@@ -56,11 +57,9 @@ since the renderer and Kornia SIFT share the cores with everything else.
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import replace
 from typing import Any
 
-import cv2
 import numpy as np
 import torch
 from tensordict import TensorDict, TensorDictBase
@@ -69,11 +68,11 @@ from torchrl.envs import EnvBase
 
 from common.threads import apply_thread_policy
 from nbv.bov.bag import BagOfViews
-from nbv.features.sift import extract_features
+from nbv.features.sift import FeatureConfig
+from nbv.features.source import ViewSource
 from nbv.recon.visibility import SurfaceVisibility, scene_visibility
 from nbv.rl.config import EnvConfig, RewardConfig
 from nbv.rl.lattice import ViewLattice, build_lattice
-from render.renderer import MitsubaRenderer
 from render.viewpoint import TWO_PI, Viewpoint, viewpoint_to_c2w
 from scenes.model import Scene
 from scenes.spec import SceneSpec
@@ -118,10 +117,14 @@ def wrap_angle(angle: float) -> float:
     return math.pi if wrapped == -math.pi else wrapped
 
 
-def gray_frame(rgb: np.ndarray, size: int) -> np.ndarray:
-    """An sRGB uint8 image as a `size` x `size` uint8 grayscale frame (area-averaged)."""
-    gray = cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY)
-    return cv2.resize(gray, (size, size), interpolation=cv2.INTER_AREA)
+def check_source(source: ViewSource, config: EnvConfig, features: FeatureConfig) -> None:
+    """Refuse a shared view source whose camera, render settings, features or frame size are not the env's."""
+    ours = (config.camera, config.render, features, config.obs_size)
+    render = replace(source.render, seed=config.render.seed)  # the env reseeds it
+    theirs = (source.camera, render, source.features, source.frame_size)
+    for name, mine, its in zip(("camera", "render", "features", "obs_size"), ours, theirs):
+        if mine != its:
+            raise ValueError(f"the view source's {name} is {its!r}, the env's {mine!r}")
 
 
 class NBVEnv(EnvBase):
@@ -133,6 +136,8 @@ class NBVEnv(EnvBase):
         seed: seed of the start viewpoints, the render noise and the BoV clustering.
         reward_terms: training-only reward terms (`TrainConfig.reward`, from `nbv.rl.builders`); by default
             none, so an env built from an `EnvConfig` alone never reads the true mesh.
+        source: the view source to render with (shared with a planner); default: a new one on the
+            config's camera, render, feature and frame settings.
 
     Example:
         >>> from render.camera import UAVCamera
@@ -143,7 +148,7 @@ class NBVEnv(EnvBase):
     """
 
     def __init__(self, config: EnvConfig, worker: int = 0, seed: int = 0,
-                 reward_terms: RewardConfig = RewardConfig()) -> None:
+                 reward_terms: RewardConfig = RewardConfig(), source: ViewSource | None = None) -> None:
         super().__init__(device="cpu", batch_size=torch.Size([]))
         self.config = config
         self.reward_terms = reward_terms
@@ -161,13 +166,14 @@ class NBVEnv(EnvBase):
             truncated=Categorical(2, shape=(1,), dtype=torch.bool),
         )
         self._scenes = config.scenes.specs()
-        self._renderers: dict[str, MitsubaRenderer] = {}
         self._lattices: dict[str, ViewLattice] = {}
-        self._loaded: dict[str, Scene] = {}
         self._visibility: dict[str, tuple[SurfaceVisibility, np.ndarray]] = {}  # with the scene centre
         self._node_seen: dict[tuple[str, int], np.ndarray] = {}
         self._seen: np.ndarray | None = None  # the episode's seen surface samples (coverage reward)
         self._features = config.bov.feature_config()
+        self.source = source or ViewSource(config.camera, config.render, self._features, config.obs_size,
+                                           seed)
+        check_source(self.source, config, self._features)
         self._bov: BagOfViews | None = None
         self._resume_pending = False
         self._view: Viewpoint | None = None
@@ -177,14 +183,9 @@ class NBVEnv(EnvBase):
 
     def _set_seed(self, seed: int | None) -> None:
         self._seed = int(seed or 0)
-        self._render = replace(self.config.render, seed=self._seed)
+        self.source.reseed(self._seed)
         self._rng = np.random.default_rng(self._seed)
         self._episode = 0
-        self._views_rendered = 0
-        self.render_seconds = 0.0  # wall time of those renders (planning time without renders)
-        self._depths_rendered = 0
-        self.depth_seconds = 0.0  # wall time of the depth images rendered (`render_depth`)
-        self.setup_seconds = 0.0  # wall time loading scenes into renderers (camera setup)
         self._bov = None
 
     def _reset(self, tensordict: TensorDictBase | None = None, **kwargs) -> TensorDictBase:
@@ -193,6 +194,7 @@ class NBVEnv(EnvBase):
             self._resume_pending = False
             return self._observation()
         self._scene = self._scenes[(self.worker + self._episode) % len(self._scenes)]
+        self.source.select(self._scene)
         self._episode += 1
         low, high = self.config.low, self.config.high
         radius, azimuth, elevation = low + self._rng.random(3) * (high - low)
@@ -244,19 +246,34 @@ class NBVEnv(EnvBase):
     @property
     def views_rendered(self) -> int:
         """Views rendered since the seed was set (`render_seconds` is their wall time)."""
-        return self._views_rendered
+        return self.source.views_rendered
+
+    @property
+    def render_seconds(self) -> float:
+        """Wall time of the views rendered (planning time without renders)."""
+        return self.source.render_seconds
 
     @property
     def depths_rendered(self) -> int:
         """Depth images rendered since the seed was set (`depth_seconds` is their wall time)."""
-        return self._depths_rendered
+        return self.source.depths_rendered
+
+    @property
+    def depth_seconds(self) -> float:
+        """Wall time of the depth images rendered (`render_depth`)."""
+        return self.source.depth_seconds
+
+    @property
+    def setup_seconds(self) -> float:
+        """Wall time loading scenes into renderers (camera setup)."""
+        return self.source.setup_seconds
 
     @property
     def scene(self) -> Scene:
         """The current scene, loaded (after the first reset)."""
         if self._view is None:
             raise RuntimeError("NBVEnv.scene needs an episode: call reset() first")
-        return self._load(self._scene)
+        return self.source.load(self._scene)
 
     @property
     def viewpoint(self) -> Viewpoint | None:
@@ -268,7 +285,7 @@ class NBVEnv(EnvBase):
         if self._view is None:
             raise RuntimeError("NBVEnv.snapshot needs an episode: call reset() first")
         return {
-            "seed": self._seed, "episode": self._episode, "views_rendered": self._views_rendered,
+            "seed": self._seed, "episode": self._episode, "views_rendered": self.source.views_rendered,
             "rng": self._rng.bit_generator.state, "scene": self._scene.scene,
             "view": self._view.as_array().tolist(), "frames": torch.from_numpy(self._frames.copy()),
             "locations": torch.from_numpy(self._locations.copy()),
@@ -279,9 +296,10 @@ class NBVEnv(EnvBase):
     def restore(self, state: dict[str, Any]) -> None:
         """Load a `snapshot`; the next reset continues the restored episode instead of starting one."""
         self._set_seed(state["seed"])
-        self._episode, self._views_rendered = int(state["episode"]), int(state["views_rendered"])
+        self._episode, self.source.views_rendered = int(state["episode"]), int(state["views_rendered"])
         self._rng.bit_generator.state = state["rng"]
         self._scene = SceneSpec(scene=str(state["scene"]), up_axis=self.config.scenes.up_axis)
+        self.source.select(self._scene)
         self._view = Viewpoint(*map(float, state["view"]))
         self._frames, self._locations = state["frames"].numpy().copy(), state["locations"].numpy().copy()
         self._progress, self._steps = float(state["progress"]), int(state["steps"])
@@ -293,23 +311,12 @@ class NBVEnv(EnvBase):
 
     def render_view(self, view: Viewpoint) -> np.ndarray:
         """The sRGB image at `view` of the current scene (advances the per-view render seed)."""
-        renderer = self._renderer(self._scene)
-        seed = self._render.view_seed(self._views_rendered)
-        self._views_rendered += 1
-        start = time.perf_counter()
-        rgb = renderer.render_rgb(viewpoint_to_c2w(view, renderer.center), seed=seed)
-        self.render_seconds += time.perf_counter() - start
-        return rgb
+        return self.source.render_rgb(view)
 
     def render_depth(self, view: Viewpoint) -> np.ndarray:
         """The z-depth image at `view` of the current scene (H x W float32 metres, 0 for no hit): what a
         depth camera returns there. Always rendered, lattice or not."""
-        renderer = self._renderer(self._scene)
-        start = time.perf_counter()
-        depth = renderer.render_depth(viewpoint_to_c2w(view, renderer.center))
-        self.depth_seconds += time.perf_counter() - start
-        self._depths_rendered += 1
-        return depth
+        return self.source.render_depth(view)
 
     def capture(self, view: Viewpoint) -> tuple[np.ndarray, torch.Tensor]:
         """The policy frame (S x S uint8) and SIFT descriptors (M, 128) of `view` of the current scene.
@@ -320,9 +327,7 @@ class NBVEnv(EnvBase):
         if self.config.lattice.enabled:
             lattice = self._lattice(self._scene)
             return lattice.observe(lattice.snap(view)[1])
-        rgb = self.render_view(view)
-        descriptors = torch.as_tensor(extract_features([rgb], self._features)[0].descriptors)
-        return gray_frame(rgb, self.config.obs_size), descriptors
+        return self.source.capture(view)
 
     def surface_seen(self, view: Viewpoint) -> np.ndarray:
         """Which of the current target's surface samples `view` sees (with a lattice: its node does)."""
@@ -337,23 +342,12 @@ class NBVEnv(EnvBase):
             self._node_seen[scene, index] = visibility.seen(viewpoint_to_c2w(node, center))
         return self._node_seen[scene, index]
 
-    def _renderer(self, spec: SceneSpec) -> MitsubaRenderer:
-        if spec.scene not in self._renderers:
-            start = time.perf_counter()
-            self._renderers[spec.scene] = MitsubaRenderer(self._load(spec), self.config.camera, self._render)
-            self.setup_seconds += time.perf_counter() - start
-        return self._renderers[spec.scene]
-
-    def _load(self, spec: SceneSpec) -> Scene:
-        if spec.scene not in self._loaded:
-            self._loaded[spec.scene] = spec.load()
-        return self._loaded[spec.scene]
-
     def _lattice(self, spec: SceneSpec) -> ViewLattice:
         """The scene's lattice: read from the cache without a renderer, or rendered now."""
         if spec.scene not in self._lattices:
-            self._lattices[spec.scene] = build_lattice(self._load(spec), lambda: self._renderer(spec),
-                                                       self.config, self._features, progress=False)
+            self._lattices[spec.scene] = build_lattice(
+                self.source.load(spec), lambda: self.source.renderer(spec), self.config, self._features,
+                progress=False)
         return self._lattices[spec.scene]
 
     def _observation(self, terminated: bool = False, truncated: bool = False) -> TensorDict:

@@ -30,6 +30,7 @@ from tqdm import tqdm
 from common.io import atomic_path, cache_dir
 from nbv.fanout.task import Task
 from nbv.features.sift import FeatureConfig, extract_features
+from nbv.features.source import gray_frame
 from nbv.rl.config import EnvConfig, LatticeConfig
 from render.renderer import MitsubaRenderer
 from render.scan_cache import scene_digest
@@ -107,8 +108,6 @@ def build_lattice(scene: Scene, make_renderer: Callable[[], MitsubaRenderer], co
                   features: FeatureConfig, progress: bool = True) -> ViewLattice:
     """The scene's lattice, read from the cache, or rendered now (node i with render seed i) by the
     renderer `make_renderer` gives (asked for only then: its variant is `config.render`'s) and cached."""
-    from nbv.rl.env import gray_frame
-
     axes = lattice_axes(config)
     path = lattice_path(scene, config, features, select_variant(config.render.variant).variant())
     if path.is_file():

@@ -1,6 +1,6 @@
 """A trained actor flying an episode: the viewpoints it chooses from the env's start view.
 
-Shared by `nbv plan --planner policy` (`nbv.planning.planners.PolicyPlanner`) and the checkpoint
+Shared by `nbv plan --planner policy` (`nbv.planning.policy.PolicyPlanner`) and the checkpoint
 selection of `nbv train` (`nbv.rl.validate`), so both score the same behaviour.
 """
 

@@ -9,16 +9,14 @@ and the score is the share of the true surface those views see (`nbv.recon.visib
 depth test at each view's exact pose). `policy.pt` keeps the best-scoring actor. The policy sees the
 nearest nodes' frames as in training; evaluation (`nbv plan`, `nbv online`) renders exact viewpoints.
 
-Model selection across runs (`scripts/select_defaults.py`) scores a run's kept actor, and the baselines,
-the way evaluation does: `validation_score`, the visible coverage of exact-render episodes in the env of
-`evaluation_env_config`, the one recipe of an env that evaluates a trained policy's settings (exact
-renders, no lattice; no training-only reward term, which lives in `TrainConfig.reward`, not in the env).
+`evaluation_env_config` is the one recipe of an env that evaluates a trained policy's settings (exact
+renders, no lattice; no training-only reward term, which lives in `TrainConfig.reward`, not in the env):
+planning with a policy and the model selection across runs (`nbv.planning.selection`) use it.
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Protocol
 
 import numpy as np
 import torch
@@ -31,14 +29,6 @@ from nbv.rl.rollout import policy_views
 from render.settings import RenderSettings
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes.spec import SceneSet
-
-
-class ViewPlanner(Protocol):
-    """Anything that chooses viewpoints in an env (every `nbv.planning` planner)."""
-
-    def plan(self, env: NBVEnv, views: int | None) -> list[Viewpoint]:
-        """The chosen viewpoints, the env's start view first."""
-        ...
 
 
 def validation_env_config(env: EnvConfig, validation: ValidationConfig) -> EnvConfig:
@@ -55,23 +45,6 @@ def evaluation_env_config(trained: EnvConfig, scenes: SceneSet, render: RenderSe
     changes = {"render": render, "episode_views": episode_views}
     return replace(trained, scenes=scenes, lattice=LatticeConfig(),
                    **{key: value for key, value in changes.items() if value is not None})
-
-
-def episode_coverage(planner: ViewPlanner, trained: EnvConfig, scene: str, views: int, seed: int) -> float:
-    """Visible-surface coverage of the true mesh by the planner's `views` viewpoints on `scene` from the
-    start view of `seed` (exact renders, `evaluation_env_config`; surface samples seeded `seed`)."""
-    config = evaluation_env_config(trained, SceneSet(scene=(scene,)))
-    chosen = planner.plan(NBVEnv(config, seed=seed), views)
-    loaded = config.scenes.specs()[0].load()
-    poses = [viewpoint_to_c2w(v, loaded.center()) for v in chosen]
-    return scene_visibility(loaded, config.camera, seed=seed).coverage(poses)
-
-
-def validation_score(planner: ViewPlanner, trained: EnvConfig, scenes: tuple[str, ...], views: int,
-                     episodes: int) -> float:
-    """The model-selection score: mean `episode_coverage` (%) over `scenes` x start views 0 .. episodes-1."""
-    return 100.0 * float(np.mean([episode_coverage(planner, trained, scene, views, seed)
-                                  for scene in scenes for seed in range(episodes)]))
 
 
 class LatticeValidator:

@@ -112,6 +112,34 @@ def test_reward_of_range_that_was_empty_is_w_minus_one():
     assert int(bov.word_count[0]) == 3
 
 
+def toy_bag(memory_cap: int) -> BagOfViews:
+    """The docstring's toy after its three kept views (range 0 holds e1, e2, e3; range 1 holds e4)."""
+    bov = BagOfViews(ranges=2, words=1, dim=4, memory_cap=memory_cap, match_cosine=PAPER_MATCH_COSINE)
+    for desc, azimuth in [(E[:2], 0.5), (E[2:3], 2.0), (E[3:4], 3.5)]:
+        bov.update(desc, azimuth)
+    return bov
+
+
+@pytest.mark.parametrize("memory_cap", [2048, 2])  # 2: range 0 is full, so a look-ahead draws a slot
+def test_a_look_ahead_reward_leaves_the_bag_as_it_was(memory_cap):
+    import copy
+
+    bov = toy_bag(memory_cap)
+    before = {k: v.clone() for k, v in bov.state_dict().items()}
+    for desc, azimuth in [(E[3:4], 2.5), (E[:1], 4.0), (rand_unit(5, 4, 1), 0.2)]:
+        expected = copy.deepcopy(bov).reward(desc, azimuth)
+        assert bov.reward(desc, azimuth, commit=False) == expected
+        assert all(torch.equal(v, before[k]) for k, v in bov.state_dict().items())
+
+
+def test_a_look_ahead_is_the_hand_worked_reward_and_a_commit_learns():
+    bov = toy_bag(2048)
+    assert bov.reward(E[3:4], 2.5, commit=False) == pytest.approx(-math.sqrt(3), abs=1e-6)
+    torch.testing.assert_close(bov.words[0, 0], torch.tensor([1.0, 1, 1, 0]) / math.sqrt(3))
+    assert bov.reward(E[3:4], 2.5) == pytest.approx(-math.sqrt(3), abs=1e-6)
+    torch.testing.assert_close(bov.words[0, 0], torch.full((4,), 0.5))
+
+
 def test_vocabulary_distance_definitions():
     w = rand_unit(5, 8, 1)
     assert vocabulary_distance(w, w, match_cosine=0.5).item() == pytest.approx(-5.0, abs=1e-5)  # cos 1: -1

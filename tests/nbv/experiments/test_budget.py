@@ -1,11 +1,12 @@
 """Coverage against view budget: prefixes of a sequential plan are its shorter plans; the table and AUC."""
 
 import json
+from dataclasses import replace
 
 import pytest
 from PIL import Image
 
-from nbv.experiments.budget import BudgetConfig, budget_rows, coverage_auc, run_budget
+from nbv.experiments.budget import SETTINGS, BudgetConfig, budget_rows, coverage_auc, run_budget
 from nbv.recon.config import MetricsConfig
 from render.camera import UAVCamera
 from render.settings import RenderSettings
@@ -28,8 +29,9 @@ def test_rows_average_seeds_then_buildings():
 
 def test_a_sequential_plans_prefix_scores_as_its_shorter_plan(tmp_path):
     config = BudgetConfig(out=tmp_path / "out", scenes=("test_building",), planners=("greedy", "circle"),
-                          seeds=(0,), budgets=(2, 3), camera=UAVCamera(48, 36), render=RenderSettings(spp=1),
-                          metrics=MetricsConfig(n_points=3000))
+                          seeds=(0,), budgets=(2, 3),
+                          settings=replace(SETTINGS, camera=UAVCamera(48, 36), render=RenderSettings(spp=1),
+                                           metrics=MetricsConfig(n_points=3000)))
     rows = run_budget(config)
     alone = run_budget(BudgetConfig(**{**config.__dict__, "out": tmp_path / "two", "budgets": (2,)}))
     for measure in ("coverage", "visible"):  # a prefix of greedy's 3-view plan is its 2-view plan

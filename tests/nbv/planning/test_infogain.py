@@ -6,12 +6,13 @@ import numpy as np
 
 from nbv.bov.config import BoVConfig
 from nbv.features.config import FeatureConfig
+from nbv.planning.config import PlanSettings
 from nbv.planning.infogain import InfoGainPlanner, target_grid
-from nbv.planning.planners import make_planner
+from nbv.planning.registry import make_planner
+from nbv.planning.world import PlanningWorld
 from nbv.recon.config import OccupancyConfig
 from nbv.recon.occupancy import UNKNOWN, OccupancyGrid
 from nbv.rl.config import EnvConfig
-from nbv.rl.env import NBVEnv
 from render.camera import UAVCamera
 from render.settings import RenderSettings
 from scenes import load_scene
@@ -25,25 +26,26 @@ CONFIG = EnvConfig(scenes=SceneSet(scene=("test_building",)), camera=UAVCamera(6
 def test_infogain_moves_to_the_candidate_of_highest_gain(monkeypatch):
     gains = iter([3, 9, 1, 4, 0, 2, 8, 5])  # step 1: candidate 1; step 2: candidate 2 (of 4 each)
     monkeypatch.setattr(OccupancyGrid, "gain", lambda self, *args: next(gains))
-    env = NBVEnv(CONFIG, seed=0)
-    views = InfoGainPlanner(candidates=4, seed=0).plan(env, 3)
+    world = PlanningWorld(CONFIG, seed=0)
+    views = InfoGainPlanner(candidates=4, seed=0).plan(world, 3)
     rng = np.random.default_rng(0)
     steps = [[tuple(CONFIG.low + rng.random(3) * (CONFIG.high - CONFIG.low)) for _ in range(4)]
              for _ in range(2)]
     assert [tuple(v.as_array()) for v in views[1:]] == [steps[0][1], steps[1][2]]
-    # Candidates are ray cast, not rendered: one RGB image (the start view) and the depth of the views
-    # flown to before the last, whose depth no decision needs.
-    assert env.views_rendered == 1 and env.depths_rendered == 2
+    # Candidates are ray cast, not rendered: no RGB image, and the depth of the views flown to before the
+    # last, whose depth no decision needs.
+    assert world.source.views_rendered == 0 and world.source.depths_rendered == 2
 
 
 def test_infogain_is_seeded_starts_at_the_start_view_and_plans_in_the_ranges():
-    env = NBVEnv(CONFIG, seed=2)
-    views = make_planner("infogain", seed=2, candidates=3).plan(env, 4)
+    world = PlanningWorld(CONFIG, seed=2)
+    views = make_planner("infogain", PlanSettings(candidates=3), seed=2).plan(world, 4)
     low, high = CONFIG.low, CONFIG.high
-    assert len(views) == 4 and views[0] == env.viewpoint  # the env stays at its start: nothing is stepped
+    assert len(views) == 4 and views[0] == world.start
     assert all(np.all(low - 1e-9 <= v.as_array()) and np.all(v.as_array() <= high) for v in views)
-    assert views == make_planner("infogain", seed=2, candidates=3).plan(NBVEnv(CONFIG, seed=2), 4)
-    assert views[0] == make_planner("greedy", seed=2, candidates=3).plan(NBVEnv(CONFIG, seed=2), 1)[0]
+    three = PlanSettings(candidates=3)
+    assert views == make_planner("infogain", three, seed=2).plan(PlanningWorld(CONFIG, seed=2), 4)
+    assert views[0] == make_planner("greedy", three, seed=2).plan(PlanningWorld(CONFIG, seed=2), 1)[0]
 
 
 def test_the_grid_covers_the_padded_target_bounds_and_starts_unknown():

@@ -7,6 +7,7 @@ import pytest
 
 from nbv.bov.config import BoVConfig
 from nbv.features.config import FeatureConfig
+from nbv.planning.config import PlanSettings
 from nbv.planning.oracle import (
     POOL,
     CoverageOraclePlanner,
@@ -16,10 +17,10 @@ from nbv.planning.oracle import (
     lattice_viewpoints,
     ones,
 )
-from nbv.planning.planners import make_planner
+from nbv.planning.registry import make_planner
+from nbv.planning.world import PlanningWorld
 from nbv.recon.visibility import scene_visibility
 from nbv.rl.config import EnvConfig
-from nbv.rl.env import NBVEnv
 from render.camera import UAVCamera
 from render.settings import RenderSettings
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
@@ -45,19 +46,23 @@ def test_the_oracle_is_never_below_another_planner(views, seed):
     # Issue 14's acceptance point, at one budget and seed. At 4 views the circle sees the whole surface:
     # greedy on the random candidates alone (seed 3: 97.3 %) or on the lattice without restarts (seed 3:
     # 99.99 %, seed 5: 99.92 %) fell short of it.
-    scores = {name: coverage(make_planner(name, seed=seed).plan(NBVEnv(CONFIG, seed=seed), views), seed)
-              for name in ("random", "circle", "greedy", "infogain", "oracle")}
+    planners = {name: make_planner(name, PlanSettings(), seed=seed) for name in
+                ("random", "circle", "greedy", "infogain", "oracle")}
+    scores = {name: coverage(planner.plan(PlanningWorld(CONFIG, seed=seed), views), seed)
+              for name, planner in planners.items()}
     assert all(scores["oracle"] >= score for score in scores.values()), str(scores)
     assert scores["oracle"] > min(scores.values())
 
 
 def test_the_oracle_plans_in_the_ranges_and_is_seeded():
     planner = CoverageOraclePlanner(candidates=2, seed=1)
-    views = planner.plan(NBVEnv(CONFIG, seed=1), 3)
+    world = PlanningWorld(CONFIG, seed=1)
+    views = planner.plan(world, 3)
+    assert world.source.views_rendered == 0 and world.source.setup_seconds == 0.0  # ray casts only
     low, high = CONFIG.low, CONFIG.high
     assert len(views) == 3 and all(np.all(low - 1e-9 <= v.as_array()) and np.all(v.as_array() <= high)
                                    for v in views)
-    assert views == CoverageOraclePlanner(candidates=2, seed=1).plan(NBVEnv(CONFIG, seed=1), 3)
+    assert views == CoverageOraclePlanner(candidates=2, seed=1).plan(PlanningWorld(CONFIG, seed=1), 3)
     assert len(lattice_viewpoints(CONFIG, POOL)) == 756
     assert Viewpoint(2.0, 0.0, np.radians(42.5)) in lattice_viewpoints(CONFIG, POOL)  # the middle ring
 

@@ -9,8 +9,9 @@ import pytest
 
 from nbv.bov.config import BoVConfig
 from nbv.cli import main
-from nbv.planning.plan import PlanConfig, planning_env_config, reference_mesh
-from nbv.planning.planners import make_planner
+from nbv.planning.config import PlanConfig, PlanSettings
+from nbv.planning.plan import planning_env_config, reference_mesh
+from nbv.planning.registry import make_planner
 from nbv.recon.config import ReconstructionConfig
 from nbv.rl.env import NBVEnv
 from render.camera import UAVCamera
@@ -57,7 +58,8 @@ def test_nbv_plan_with_the_oracle_and_information_gain(planner, tmp_path, capsys
     assert ("reference" in plan) == (planner == "oracle")
     assert plan["planner"] == planner and plan["views"] == 3 and len(read_dataset(out / "views")) == 3
     assert 0.0 < plan["gt"]["coverage"] <= 1.0 and 0.0 <= plan["deciding_s"] <= plan["planning_s"]
-    assert plan["config"]["candidates"] == 2 and plan["config"]["occupancy"]["grid_resolution"] == 16
+    settings = plan["config"]["settings"]
+    assert settings["candidates"] == 2 and settings["occupancy"]["grid_resolution"] == 16
     assert f'"planner": "{planner}"' in capsys.readouterr().out
 
 
@@ -68,22 +70,23 @@ def test_nbv_plan_unknown_planner_is_a_clear_error(tmp_path, capsys):
 
 def test_reference_is_the_cached_full_scan_reconstruction(tmp_path):
     recon = ReconstructionConfig(voxel_size_m=0.02, truncation_m=0.08)  # 4 voxels, as before
-    config = PlanConfig(scene=SceneSpec(scene="test_building"), out=tmp_path / "plan",
-                        camera=UAVCamera(48, 36), render=RenderSettings(spp=1), recon=recon)
-    path = reference_mesh(config)
+    scene = SceneSpec(scene="test_building")  # no seed among the arguments: one reference for all
+    settings = PlanSettings(camera=UAVCamera(48, 36), render=RenderSettings(spp=1), recon=recon)
+    path = reference_mesh(scene, settings)
     assert path.name == "mesh.ply" and path.parent.name == "reconstruction_20mm"
     assert len(read_dataset(path.parent.parent)) == 288  # the paper's full hemisphere scan
     stamp = path.stat().st_mtime_ns
-    assert reference_mesh(config) == path and path.stat().st_mtime_ns == stamp  # reused, not rebuilt
-    assert reference_mesh(replace(config, seed=3)) == path and path.stat().st_mtime_ns == stamp  # seed-free
-    other = replace(config, recon=replace(config.recon, truncation_m=0.06))
-    assert reference_mesh(other) == path and path.stat().st_mtime_ns != stamp  # other fusion settings: redone
+    assert reference_mesh(scene, settings) == path and path.stat().st_mtime_ns == stamp  # reused, not rebuilt
+    other = replace(settings, recon=replace(settings.recon, truncation_m=0.06))
+    assert reference_mesh(scene, other) == path and path.stat().st_mtime_ns != stamp  # other fusion: redone
 
 
 def test_the_plans_bov_and_camera_reach_the_greedy_planners_env(tmp_path):
+    settings = PlanSettings(camera=UAVCamera(64, 48, focal_mm=20.0),
+                            bov=BoVConfig(ranges=4, match_cosine=0.6))
     config = PlanConfig(scene=SceneSpec(scene="house.obj", up_axis="y"), planner="greedy", out=tmp_path,
-                        camera=UAVCamera(64, 48, focal_mm=20.0), bov=BoVConfig(ranges=4, match_cosine=0.6))
-    env = NBVEnv(planning_env_config(config, make_planner("greedy")))
+                        settings=settings)
+    env = NBVEnv(planning_env_config(config, make_planner("greedy", settings)))
     assert env.bov.match_cosine == 0.6 and env.bov.ranges == 4
     assert env.config.camera.focal_mm == 20.0
     assert env.config.scenes == SceneSet(scene=("house.obj",), up_axis="y")
@@ -96,7 +99,7 @@ def test_choose_views_plans_on_the_thread_policy_and_restores_torch(tmp_path, mo
     from nbv.planning.plan import choose_views, scan_env_config
 
     class Recorder:
-        def plan(self, env, views):
+        def plan(self, world, views):
             seen.append(torch.get_num_threads())
             return []
 
@@ -105,9 +108,9 @@ def test_choose_views_plans_on_the_thread_policy_and_restores_torch(tmp_path, mo
     monkeypatch.setattr(threads, "_chosen", None)
     try:
         torch.set_num_threads(2)
-        choose_views(config, Recorder(), scan_env_config(config))
+        choose_views(config, Recorder(), scan_env_config(config.scene, config.settings))
         threads.set_torch_threads(2)  # a process that chose keeps its choice
-        choose_views(config, Recorder(), scan_env_config(config))
+        choose_views(config, Recorder(), scan_env_config(config.scene, config.settings))
         assert seen == [threads.worker_threads(), 2] and torch.get_num_threads() == 2
     finally:
         torch.set_num_threads(before)
@@ -125,17 +128,17 @@ def test_choose_views_counts_the_simulated_camera_apart_from_deciding(tmp_path):
     from nbv.planning.plan import choose_views, scan_env_config
 
     class Looker:  # renders 3 candidates beside its start view, flies to one view
-        def plan(self, env, views):
-            self.env = env
-            env.reset()
-            for azimuth in (0.5, 1.5, 2.5):
-                env.render_view(Viewpoint(env.viewpoint.radius, azimuth, env.viewpoint.elevation))
-            return [env.viewpoint]
+        def plan(self, world, views):
+            self.world = world
+            start = world.start
+            for azimuth in (start.azimuth, 0.5, 1.5, 2.5):
+                world.source.render_rgb(Viewpoint(start.radius, azimuth, start.elevation))
+            return [start]
 
-    config = PlanConfig(scene=SceneSpec(scene="test_building"), out=tmp_path, camera=UAVCamera(48, 36),
-                        render=RenderSettings(spp=1))
+    config = PlanConfig(scene=SceneSpec(scene="test_building"), out=tmp_path,
+                        settings=PlanSettings(camera=UAVCamera(48, 36), render=RenderSettings(spp=1)))
     looker = Looker()
-    views, seconds, camera = choose_views(config, looker, scan_env_config(config))
-    env = looker.env
-    assert len(views) == 1 and env.views_rendered == 4 and env.setup_seconds > 0
-    assert camera == pytest.approx(env.setup_seconds + env.render_seconds / 4) and camera < seconds
+    views, seconds, camera = choose_views(config, looker, scan_env_config(config.scene, config.settings))
+    clock = looker.world.source
+    assert len(views) == 1 and clock.views_rendered == 4 and clock.setup_seconds > 0
+    assert camera == pytest.approx(clock.setup_seconds + clock.render_seconds / 4) and camera < seconds

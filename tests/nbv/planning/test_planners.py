@@ -11,17 +11,11 @@ import torch
 
 from nbv.bov.config import BoVConfig
 from nbv.features.config import FeatureConfig
-from nbv.planning.planners import (
-    SHIPPED_POLICY,
-    CirclePlanner,
-    GreedyBoVPlanner,
-    HemispherePlanner,
-    PolicyPlanner,
-    RandomPlanner,
-    make_planner,
-    planner_label,
-    split_policy_spec,
-)
+from nbv.planning.config import PlanSettings
+from nbv.planning.planners import CirclePlanner, GreedyBoVPlanner, HemispherePlanner, RandomPlanner
+from nbv.planning.policy import PolicyPlanner
+from nbv.planning.registry import SHIPPED_POLICY, entry, make_planner, planner_label, split_spec
+from nbv.planning.world import PlanningWorld
 from nbv.rl.builders import make_loss_module, make_optimizers, make_replay_buffer, make_sac_agent
 from nbv.rl.checkpoint import CheckpointError, save_checkpoint
 from nbv.rl.config import EnvConfig, LatticeConfig, LoggerConfig, OptimConfig, TrainConfig
@@ -33,13 +27,21 @@ from render.viewpoint import Viewpoint
 from scenes.spec import SceneSet
 
 TEST_BUILDING = SceneSet(scene=("test_building",))
+PLAN = PlanSettings()
+
+
+def tiny_config(**kwargs) -> EnvConfig:
+    settings = dict(scenes=TEST_BUILDING, camera=UAVCamera(64, 48), render=RenderSettings(spp=1),
+                    bov=BoVConfig(ranges=8, sift=FeatureConfig(backend="opencv")), obs_size=32, max_steps=4)
+    return EnvConfig(**{**settings, **kwargs})
 
 
 def tiny_env(seed: int = 0, **kwargs) -> NBVEnv:
-    settings = dict(scenes=TEST_BUILDING, camera=UAVCamera(64, 48), render=RenderSettings(spp=1),
-                    bov=BoVConfig(ranges=8, sift=FeatureConfig(backend="opencv")), obs_size=32, max_steps=4)
-    config = EnvConfig(**{**settings, **kwargs})
-    return NBVEnv(config, seed=seed)
+    return NBVEnv(tiny_config(**kwargs), seed=seed)
+
+
+def tiny_world(seed: int = 0, **kwargs) -> PlanningWorld:
+    return PlanningWorld(tiny_config(**kwargs), seed=seed)
 
 
 def in_ranges(view: Viewpoint, config: EnvConfig) -> bool:
@@ -50,44 +52,56 @@ def in_ranges(view: Viewpoint, config: EnvConfig) -> bool:
 
 @pytest.mark.parametrize("planner", [RandomPlanner(seed=3), CirclePlanner(), GreedyBoVPlanner(candidates=2)])
 def test_baselines_return_the_asked_number_of_valid_views(planner):
-    env = tiny_env()
-    views = planner.plan(env, 3)
-    assert len(views) == 3 and all(isinstance(v, Viewpoint) and in_ranges(v, env.config) for v in views)
+    world = tiny_world()
+    views = planner.plan(world, 3)
+    assert len(views) == 3 and all(isinstance(v, Viewpoint) and in_ranges(v, world.env) for v in views)
 
 
 def test_random_is_seeded_and_circle_is_evenly_spaced():
-    env = tiny_env()
-    assert RandomPlanner(seed=1).plan(env, 4) == RandomPlanner(seed=1).plan(env, 4)
-    assert RandomPlanner(seed=1).plan(env, 4) != RandomPlanner(seed=2).plan(env, 4)
-    circle = CirclePlanner().plan(env, 4)
+    world = tiny_world()
+    assert RandomPlanner(seed=1).plan(world, 4) == RandomPlanner(seed=1).plan(world, 4)
+    assert RandomPlanner(seed=1).plan(world, 4) != RandomPlanner(seed=2).plan(world, 4)
+    circle = CirclePlanner().plan(world, 4)
     assert [v.azimuth for v in circle] == pytest.approx([0, math.pi / 2, math.pi, 3 * math.pi / 2])
-    assert len(CirclePlanner().plan(env, None)) == 13
+    assert len(CirclePlanner().plan(world, None)) == 13
+    assert world.source.views_rendered == 0 and world.source.setup_seconds == 0.0  # nothing rendered
 
 
-def test_greedy_picks_the_candidate_of_highest_reward(monkeypatch):
-    env = tiny_env()
-    env.reset()
+def test_greedy_picks_the_candidate_of_highest_reward_without_committing_a_candidate(monkeypatch):
+    world = tiny_world()
     planner = GreedyBoVPlanner(candidates=3, seed=0)
     rewards = iter([1.0, 5.0, 2.0])
-    chosen_candidates = []
+    captured, looked = [], []
 
     def fake_capture(view):
-        chosen_candidates.append(view)
+        captured.append(view)
         return None, torch.zeros(0, 128)
 
-    monkeypatch.setattr(env, "reset", lambda: None)
-    monkeypatch.setattr(env, "capture", fake_capture)
-    monkeypatch.setattr(type(env.bov), "reward", lambda self, d, az, el: next(rewards))
-    views = planner.plan(env, 2)
-    assert views[1] == chosen_candidates[1]
+    def fake_reward(self, descriptors, azimuth, elevation, commit=True):
+        looked.append(commit)
+        return next(rewards)
+
+    monkeypatch.setattr(world.source, "capture", fake_capture)
+    monkeypatch.setattr(type(world.bov), "reward", fake_reward)
+    views = planner.plan(world, 2)
+    assert captured[0] == world.start and views[1] == captured[2]  # the start view, then candidate 1
+    assert looked == [False, False, False]
+
+
+def test_the_world_starts_where_the_env_starts():
+    env, world = tiny_env(seed=5), tiny_world(seed=5)
+    env.reset()
+    assert world.start == env.viewpoint and world.scene == env._scene
+    assert world.bov.state_dict().keys() == env.bov.state_dict().keys() and world.bov.seed == env.bov.seed
+    assert GreedyBoVPlanner(candidates=2, seed=5).plan(world, 2)[0] == env.viewpoint
 
 
 def test_hemisphere_is_the_full_scan():
-    env = tiny_env()
-    views = HemispherePlanner().plan(env, None)
+    world = tiny_world()
+    views = HemispherePlanner().plan(world, None)
     assert len(views) > 100 and all(v.radius == pytest.approx(2.0) for v in views)
     with pytest.raises(ValueError, match="would cut it"):
-        HemispherePlanner().plan(env, 10)
+        HemispherePlanner().plan(world, 10)
 
 
 def save_untrained_policy(path, env: NBVEnv) -> None:
@@ -102,41 +116,43 @@ def save_untrained_policy(path, env: NBVEnv) -> None:
 def test_policy_planner_from_checkpoint(tmp_path):
     env = tiny_env(max_steps=3)
     save_untrained_policy(tmp_path / "checkpoint.pt", env)
-    planner = make_planner(f"policy:{tmp_path / 'checkpoint.pt'}")
+    planner = make_planner(f"policy:{tmp_path / 'checkpoint.pt'}", PLAN)
     assert isinstance(planner, PolicyPlanner) and planner.env_config == env.config  # nested, rebuilt
-    views = planner.plan(env, None)  # until the episode ends: at most the step cap
+    world = tiny_world(max_steps=3)
+    views = planner.plan(world, None)  # until the episode ends: at most the step cap
     assert 2 <= len(views) <= 4 and all(in_ranges(v, env.config) for v in views)
-    assert len(planner.plan(tiny_env(), 5)) == 5
+    assert views[0] == world.start and world.source.views_rendered == len(views)  # on the world's clock
+    assert len(planner.plan(tiny_world(), 5)) == 5
     with pytest.raises(ValueError, match="obs_size"):
-        planner.plan(NBVEnv(EnvConfig(scenes=TEST_BUILDING, obs_size=16)), 2)
+        planner.plan(PlanningWorld(EnvConfig(scenes=TEST_BUILDING, obs_size=16)), 2)
 
 
 def test_sampled_policy_is_seeded_and_spread(tmp_path):
     (tmp_path / "run").mkdir()
     save_untrained_policy(tmp_path / "run" / "checkpoint.pt", tiny_env())
     spec = f"policy-sample:{tmp_path / 'run' / 'checkpoint.pt'}"
-    sampled = make_planner(spec, seed=1)
+    sampled = make_planner(spec, PLAN, seed=1)
     assert isinstance(sampled, PolicyPlanner) and sampled.sample
-    first = sampled.plan(tiny_env(), 4)
-    assert first == make_planner(spec, seed=1).plan(tiny_env(), 4)  # seeded: the same draws
-    assert first != make_planner(spec, seed=2).plan(tiny_env(), 4)
-    assert all(in_ranges(v, tiny_env().config) for v in first)
-    mode = make_planner(f"policy:{tmp_path / 'run' / 'checkpoint.pt'}", seed=1).plan(tiny_env(), 4)
-    assert mode != first and mode == make_planner(f"policy:{tmp_path / 'run' / 'checkpoint.pt'}",
-                                                  seed=2).plan(tiny_env(), 4)  # the mode ignores the seed
+    first = sampled.plan(tiny_world(), 4)
+    assert first == make_planner(spec, PLAN, seed=1).plan(tiny_world(), 4)  # seeded: the same draws
+    assert first != make_planner(spec, PLAN, seed=2).plan(tiny_world(), 4)
+    assert all(in_ranges(v, tiny_config()) for v in first)
+    mode_spec = f"policy:{tmp_path / 'run' / 'checkpoint.pt'}"
+    mode = make_planner(mode_spec, PLAN, seed=1).plan(tiny_world(), 4)
+    assert mode != first and mode == make_planner(mode_spec, PLAN, seed=2).plan(tiny_world(), 4)  # seed-free
     assert planner_label(spec) == "policy-sample-run" and planner_label("greedy") == "greedy"
 
 
 def test_bad_planner_specs(tmp_path):
     with pytest.raises(ValueError, match="unknown planner"):
-        make_planner("best")
+        make_planner("best", PLAN)
     with pytest.raises(CheckpointError, match="not found"):
-        make_planner("policy:/nonexistent/checkpoint.pt")
+        make_planner("policy:/nonexistent/checkpoint.pt", PLAN)
     flat = {"env": {"scene": ["test_building"], "width": 64, "bov_ranges": 8}, "network": {}}  # old layout
     save_checkpoint(tmp_path / "old.pt", {"config": json.dumps(flat), "loss": {}, "optim_actor": {},
                                           "optim_critic": {}, "buffer": {}, "counters": {}, "rng": {}})
     with pytest.raises(CheckpointError, match="config does not fit.*no field.*bov_ranges"):
-        make_planner(f"policy:{tmp_path / 'old.pt'}")
+        make_planner(f"policy:{tmp_path / 'old.pt'}", PLAN)
 
 
 def test_policy_file_plans_like_its_checkpoint(tmp_path):
@@ -144,15 +160,19 @@ def test_policy_file_plans_like_its_checkpoint(tmp_path):
     save_untrained_policy(tmp_path / "checkpoint.pt", env)
     policy = tmp_path / "policy.pt"  # written beside every checkpoint: the actor and config alone
     assert policy.stat().st_size < (tmp_path / "checkpoint.pt").stat().st_size
-    from_file = make_planner(f"policy:{policy}").plan(tiny_env(max_steps=3), 4)
-    assert from_file == make_planner(f"policy:{tmp_path / 'checkpoint.pt'}").plan(tiny_env(max_steps=3), 4)
+    from_file = make_planner(f"policy:{policy}", PLAN).plan(tiny_world(max_steps=3), 4)
+    same = make_planner(f"policy:{tmp_path / 'checkpoint.pt'}", PLAN).plan(tiny_world(max_steps=3), 4)
+    assert from_file == same
 
 
 def test_bare_policy_spec_is_the_shipped_policy():
-    assert split_policy_spec("policy") == ("policy", str(SHIPPED_POLICY))
-    assert split_policy_spec("policy-sample") == ("policy-sample", str(SHIPPED_POLICY))
-    assert split_policy_spec("policy:run/policy.pt") == ("policy", "run/policy.pt")
-    assert planner_label("policy") == "policy-shipped" and split_policy_spec("random") is None
+    assert split_spec("policy") == (entry("policy"), None)  # no checkpoint: the factory takes the shipped one
+    assert split_spec("policy-sample:run/policy.pt") == (entry("policy-sample"), "run/policy.pt")
+    assert split_spec("random") == (entry("random"), None) and not entry("random").checkpoint
+    assert planner_label("policy") == "policy-shipped"
+    made = make_planner("policy", PLAN).actor.state_dict()
+    shipped = PolicyPlanner(SHIPPED_POLICY).actor.state_dict()
+    assert made.keys() == shipped.keys() and all(torch.equal(made[k], shipped[k]) for k in made)
 
 
 def test_shipped_policy_is_the_default_training_command_and_plans():
@@ -166,8 +186,8 @@ def test_shipped_policy_is_the_default_training_command_and_plans():
     default = config_record(parse_train(["--out", "runs/default"]))
     for group in ("env", "collector", "replay_buffer", "optim", "network", "validation"):
         assert shipped[group] == default[group], group  # `nbv train --out runs/default` retrains it
-    planner = make_planner("policy")
+    planner = make_planner("policy", PLAN)
     assert isinstance(planner, PolicyPlanner) and planner.env_config.bov.elevation_bands == 2
-    env = NBVEnv(replace(planner.env_config, scenes=TEST_BUILDING, lattice=LatticeConfig()))
-    views = planner.plan(env, 3)
-    assert len(views) == 3 and all(in_ranges(v, env.config) for v in views)
+    world = PlanningWorld(replace(planner.env_config, scenes=TEST_BUILDING, lattice=LatticeConfig()))
+    views = planner.plan(world, 3)
+    assert len(views) == 3 and all(in_ranges(v, world.env) for v in views)

@@ -12,8 +12,9 @@ from tensordict import TensorDict
 from nbv.bov.config import BoVConfig
 from nbv.features.config import FeatureConfig
 from nbv.features.sift import extract_features
+from nbv.features.source import gray_frame
 from nbv.rl.config import EnvConfig, LatticeConfig
-from nbv.rl.env import NBVEnv, gray_frame
+from nbv.rl.env import NBVEnv
 from nbv.rl.lattice import ViewLattice, lattice_axes
 from render.camera import UAVCamera
 from render.settings import RenderSettings
@@ -73,7 +74,7 @@ def test_env_on_a_lattice_sees_cached_node_renders_and_reuses_the_cache(monkeypa
     lattice = env._lattice(env._scene)
     node, index = lattice.snap(start)
     assert np.array_equal(td["pixels"][-1].numpy(), lattice.frames[index])
-    renderer = env._renderer(env._scene)
+    renderer = env.source.renderer(env._scene)
     rgb = renderer.render_rgb(viewpoint_to_c2w(node, renderer.center), seed=index)
     frame, descriptors = lattice.observe(index)
     assert np.array_equal(frame, gray_frame(rgb, 16))
@@ -110,13 +111,13 @@ def test_relative_steps_on_a_lattice_accumulate_from_the_exact_viewpoint(tmp_pat
 
 def test_planning_env_renders_exact_viewpoints(tmp_path):
     from nbv.planning.plan import planning_env_config
-    from nbv.planning.planners import PolicyPlanner
+    from nbv.planning.policy import PolicyPlanner
 
     class Trained(PolicyPlanner):
         def __init__(self) -> None:
             self.env_config = config()
 
-    from nbv.planning.plan import PlanConfig
+    from nbv.planning.config import PlanConfig
     from scenes.spec import SceneSpec
 
     plan = PlanConfig(scene=SceneSpec(scene="test_building"), planner="policy:x", out=tmp_path)

@@ -1,5 +1,5 @@
 """Checkpoint selection on validation buildings: the score against a direct count, and training with it;
-the model-selection score of `scripts/select_defaults.py` and its evaluation env."""
+the evaluation env (the model-selection score itself: tests/nbv/planning/test_selection.py)."""
 
 from __future__ import annotations
 
@@ -17,13 +17,7 @@ from nbv.rl.config import LatticeConfig, ValidationConfig
 from nbv.rl.env import NBVEnv
 from nbv.rl.rollout import policy_views
 from nbv.rl.train import train_run
-from nbv.rl.validate import (
-    LatticeValidator,
-    episode_coverage,
-    evaluation_env_config,
-    validation_env_config,
-    validation_score,
-)
+from nbv.rl.validate import LatticeValidator, evaluation_env_config, validation_env_config
 from render.settings import RenderSettings
 from render.viewpoint import viewpoint_to_c2w
 from scenes.spec import SceneSet
@@ -95,48 +89,6 @@ def test_bad_validation_settings_are_refused():
     with pytest.raises(ValueError, match="validation_views must be >= 1"):
         ValidationConfig(validation_views=0)
     assert not ValidationConfig().enabled and VALIDATION.enabled
-
-
-class Mode:
-    """An untrained actor's mode as a planner (what the selection scores for a run's policy.pt)."""
-
-    def __init__(self, config) -> None:
-        torch.manual_seed(0)
-        self.actor = make_actor(config.env.history, config.env.obs_size, config.network)
-        self.envs = []
-
-    def plan(self, env: NBVEnv, views: int | None) -> list:
-        self.envs.append(env)
-        return policy_views(self.actor, env, views)
-
-
-def script_episode_coverage(planner, env_config, scene: str, views: int, seed: int) -> float:
-    """scripts/select_defaults.py's `episode_coverage` as it was before the library took it over (d439c96)."""
-    config = replace(env_config, scenes=SceneSet(scene=(scene,)), lattice=LatticeConfig())
-    chosen = planner.plan(NBVEnv(config, seed=seed), views)
-    loaded = config.scenes.specs()[0].load()
-    poses = [viewpoint_to_c2w(v, loaded.center()) for v in chosen]
-    return scene_visibility(loaded, config.camera, seed=seed).coverage(poses)
-
-
-def test_selection_score_is_the_scripts_exact_render_coverage(tmp_path, cache, monkeypatch):
-    import nbv.rl.env
-    from nbv.planning.planners import CirclePlanner, RandomPlanner
-
-    config = validated(tmp_path, 2)
-    trained = replace(config.env, lattice=replace(SMALL_LATTICE, enabled=True))  # trained on a lattice
-    mode = Mode(config)
-    planners = {"mode": mode, "circle": CirclePlanner(), "random": RandomPlanner(seed=3)}
-    expected = {name: [script_episode_coverage(planner, trained, "test_building", 3, seed) for seed in (0, 1)]
-                for name, planner in planners.items()}
-    monkeypatch.setattr(nbv.rl.env, "scene_visibility", None)  # the scoring env itself ray-casts nothing
-    for name, planner in planners.items():
-        scores = [episode_coverage(planner, trained, "test_building", 3, seed) for seed in (0, 1)]
-        assert scores == expected[name], name
-        score = validation_score(planner, trained, ("test_building",), 3, 2)
-        assert score == 100.0 * float(np.mean(expected[name])), name
-    assert 0 < min(expected["circle"]) and len({*expected["mode"], *expected["random"]}) > 1
-    assert all(not env.config.lattice.enabled and env.views_rendered > 0 for env in mode.envs)  # exact views
 
 
 def test_the_evaluation_env_renders_exactly_the_trained_settings_on_other_scenes():

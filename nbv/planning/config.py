@@ -1,0 +1,71 @@
+"""Settings of a planned scan: what every planned scan of a study shares, and `nbv plan`'s own.
+
+Light on purpose (no torch, Mitsuba or Open3D), so the command line and the study drivers build their
+parsers and configs without loading a renderer. The planner names come from the registry
+(`nbv.planning.registry`), which is light too.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated
+
+from tyro.conf import arg
+
+from nbv.bov.config import BoVConfig
+from nbv.planning.registry import entry, planner_help
+from nbv.recon.config import MetricsConfig, OccupancyConfig, ReconstructionConfig
+from render.camera import UAVCamera
+from render.settings import RenderSettings
+from scenes.spec import SceneSpec
+
+
+@dataclass(frozen=True, kw_only=True)
+class PlanSettings:
+    """What every planned scan of a study shares: camera, rendering, Bag of Views, fusion, scoring."""
+
+    camera: UAVCamera = UAVCamera()
+    """The camera of the captured views (a policy plans at its training resolution)."""
+    render: RenderSettings = RenderSettings()
+    """How views are rendered."""
+    bov: BoVConfig = BoVConfig(ranges=8)
+    """The Bag of Views of the greedy planner's reward (a policy keeps its training one)."""
+    candidates: int = 8
+    """Greedy, oracle and infogain planners: candidate viewpoints per step (only greedy renders them)."""
+    occupancy: OccupancyConfig = OccupancyConfig()
+    """The infogain planner's occupancy grid."""
+    reference: Path | None = None
+    """Reference mesh (full-scan reconstruction); default: reconstruct the hemisphere scan, cached."""
+    full_scan: bool = True
+    """Also score against the full scan's reconstruction (`reference`); off: against the ground truth only
+    (no hemisphere scan to render)."""
+    metrics: MetricsConfig = MetricsConfig()
+    """How the reconstruction is scored."""
+    recon: ReconstructionConfig = ReconstructionConfig()
+    """TSDF fusion of the captured views (and of the reference scan)."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class PlanConfig:
+    """Settings of `nbv plan`."""
+
+    scene: SceneSpec
+    """The target."""
+    views: int | None = None
+    """Number of views; default: the policy's episode, the whole hemisphere, or 13 (paper Fig. 1)."""
+    planner: Annotated[str, arg(help=planner_help())] = "random"
+    out: Path
+    """Output folder: views/, mesh.ply, points.ply, gt.ply, metrics.json, heatmap.*, trajectory.png,
+    plan.json."""
+    seed: int = 0
+    """Seed of the planner, the start view, the renders and the metrics' sampling."""
+    overwrite: bool = False
+    """Replace a non-empty output folder."""
+    settings: Annotated[PlanSettings, arg(name="")] = PlanSettings()
+    """What every planned scan of a study shares."""
+
+    def __post_init__(self) -> None:
+        if self.views is not None and self.views < 1:
+            raise ValueError(f"views must be >= 1 (or left out for the planner's default), got {self.views}")
+        entry(self.planner)  # an unknown planner fails here, naming every one

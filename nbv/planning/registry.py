@@ -1,0 +1,173 @@
+"""Every planner by name: one `PlannerEntry` each, in `PLANNERS` (docs/rl.md §10).
+
+Light on purpose: a factory is named as "module:callable" and imported only when a planner is made, so
+the command line lists the planners without loading torch or a renderer. Every list of planner names
+(`nbv plan --help`, the study drivers' defaults, README.md, docs/rl.md §10) is generated from here, so
+adding a planner is its own file plus one entry below.
+
+A spec names a planner, optionally with a checkpoint: `policy:runs/x/policy.pt`. An entry that takes a
+checkpoint (`checkpoint=True`) runs the shipped policy (`SHIPPED_POLICY`) without one.
+"""
+
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from nbv.planning.base import Planner
+    from nbv.planning.config import PlanSettings
+
+SHIPPED_POLICY = Path(__file__).with_name("shipped") / "policy.pt"
+"""The policy of the default `nbv train` command, shipped with the toolkit (its config, metrics log and
+learning curves beside it): what `policy` and `policy-sample` without a checkpoint use."""
+
+
+@dataclass(frozen=True)
+class PlannerEntry:
+    """One planner: its name, what it is, how to make it, and what a study needs to know of it."""
+
+    name: str
+    """The spec's name, e.g. "greedy" (`--planner greedy`)."""
+    summary: str
+    """One line: the `--help` and docs text."""
+    factory: str
+    """"module:callable", imported lazily; callable(settings: PlanSettings, seed: int,
+    checkpoint: str | None) -> Planner."""
+    settings: tuple[str, ...] = ()
+    """The `PlanSettings` fields it reads (e.g. ("candidates", "occupancy"))."""
+    reads_truth: bool = False
+    """It uses the true mesh (the oracle): an upper bound, not a planner a UAV has."""
+    prefixes: bool = True
+    """Its plan for n views starts with its plan for fewer (sequential); False: planned afresh per budget
+    (circle, oracle) or not cut at all (hemisphere)."""
+    checkpoint: bool = False
+    """It takes ':CHECKPOINT' (policy, policy-sample); without one the shipped policy."""
+    budget: bool = True
+    """One of the budget study's default planners (False: the fixed hemisphere scan, the policy's sampled
+    twin)."""
+
+    @property
+    def spec(self) -> str:
+        """How the spec is written: the name, with `[:CHECKPOINT]` when it takes one."""
+        return f"{self.name}[:CHECKPOINT]" if self.checkpoint else self.name
+
+
+PLANNERS: tuple[PlannerEntry, ...] = (
+    PlannerEntry("random", "viewpoints uniform in the allowed ranges (seeded)",
+                 "nbv.planning.planners:random_planner"),
+    PlannerEntry("circle", "evenly spaced azimuths at the middle radius and elevation",
+                 "nbv.planning.planners:circle_planner", prefixes=False),
+    PlannerEntry("greedy", "greedy Bag of Views: from the start view, render K (--candidates) random "
+                 "candidates per step, move to the one of highest Bag of Views reward (no learning)",
+                 "nbv.planning.planners:greedy_planner", settings=("candidates", "bov")),
+    PlannerEntry("hemisphere", "the full hemisphere scan at the middle radius (288 views with the default "
+                 "camera)", "nbv.planning.planners:hemisphere_planner", prefixes=False, budget=False),
+    PlannerEntry("infogain", "volumetric information gain (model-free, from depth): move to the one of K "
+                 "random candidates (greedy's stream) that would see the most unknown voxels of an occupancy "
+                 "grid carved from the depth of the views flown to",
+                 "nbv.planning.infogain:infogain_planner", settings=("candidates", "occupancy")),
+    PlannerEntry("policy", "a trained actor (a `nbv train` checkpoint.pt or policy.pt; none: the shipped "
+                 "policy) from the start view, acting on its distribution's mode",
+                 "nbv.planning.policy:policy_planner", checkpoint=True),
+    PlannerEntry("policy-sample", "the same, acting on seeded draws from the distribution",
+                 "nbv.planning.policy:sampled_policy_planner", checkpoint=True, budget=False),
+    PlannerEntry("oracle", "the views among the start view, greedy's candidates and a 756-view lattice "
+                 "that see the most true surface (greedy from 8 starts, then swaps)",
+                 "nbv.planning.oracle:oracle_planner", settings=("candidates",), reads_truth=True,
+                 prefixes=False),
+)
+"""The shipped planners, in the order every generated list gives them."""
+
+_REGISTERED: dict[str, PlannerEntry] = {e.name: e for e in PLANNERS}
+
+
+def register(planner: PlannerEntry) -> PlannerEntry:
+    """Add a planner (a plug-in's, or a test's); a ValueError if its name is taken or holds a ':'."""
+    if ":" in planner.name or not planner.name:
+        raise ValueError(f"a planner name must be non-empty and hold no ':', got {planner.name!r}")
+    if planner.name in _REGISTERED:
+        raise ValueError(f"planner {planner.name!r} is registered already")
+    _REGISTERED[planner.name] = planner
+    return planner
+
+
+def unregister(name: str) -> None:
+    """Remove a registered planner (a test's toy, afterwards)."""
+    _REGISTERED.pop(name)
+
+
+def entries() -> tuple[PlannerEntry, ...]:
+    """Every planner, the shipped ones first in `PLANNERS` order, then the registered ones."""
+    return tuple(_REGISTERED.values())
+
+
+def entry(spec: str) -> PlannerEntry:
+    """The entry of a spec (`name` or `name:CHECKPOINT`); a ValueError listing every planner if unknown."""
+    name, sep, _ = spec.partition(":")
+    found = _REGISTERED.get(name)
+    if found is None or (sep and not found.checkpoint):
+        raise ValueError(f"unknown planner {spec!r}; use {', '.join(e.spec for e in entries())}")
+    return found
+
+
+def split_spec(spec: str) -> tuple[PlannerEntry, str | None]:
+    """The entry of a spec and its checkpoint (None where none is named)."""
+    found = entry(spec)
+    _, sep, checkpoint = spec.partition(":")
+    return found, checkpoint if sep else None
+
+
+def make_planner(spec: str, settings: PlanSettings, seed: int = 0) -> Planner:
+    """The planner a spec names, under the plan's settings and seed (its factory imported now)."""
+    found, checkpoint = split_spec(spec)
+    module, _, attribute = found.factory.partition(":")
+    factory = importlib.import_module(module)
+    for part in attribute.split("."):
+        factory = getattr(factory, part)
+    return factory(settings, seed, checkpoint)
+
+
+def planner_label(spec: str) -> str:
+    """A short, file-name-safe label of a planner spec: a policy is named after its run folder."""
+    found, checkpoint = split_spec(spec)
+    if found.checkpoint:
+        return f"{found.name}-{Path(checkpoint or SHIPPED_POLICY).resolve().parent.name}"  # policy-shipped
+    return spec
+
+
+def planner_help() -> str:
+    """The `--planner` help text: every planner with its summary."""
+    lines = [f"{e.spec}: {e.summary}" + (" [reads the true mesh]" if e.reads_truth else "")
+             for e in entries()]
+    return "One of:\n" + "\n".join(f"- {line}" for line in lines)
+
+
+def planner_specs() -> str:
+    """Every spec, comma-separated, the oracle-like ones marked: for the study drivers' `--help`."""
+    return ", ".join(e.spec + (" (reads the true mesh: an upper bound)" if e.reads_truth else "")
+                     for e in entries())
+
+
+def planner_choices() -> str:
+    """The specs in braces, as the README's synopsis writes them: {random,circle,...}."""
+    return "{" + ",".join(e.spec for e in entries()) + "}"
+
+
+def docs_table() -> str:
+    """The Markdown table of planners in docs/rl.md §10 (a test keeps the page equal to it)."""
+    rows = [f"| `{e.spec}` | {'**upper bound, reads the true mesh**: ' if e.reads_truth else ''}"
+            f"{e.summary} |" for e in entries()]
+    return "\n".join(["| spec | planner |", "| --- | --- |", *rows])
+
+
+def budget_planners() -> tuple[str, ...]:
+    """The budget study's default planners: every entry with `budget` set, in registry order."""
+    return tuple(e.name for e in entries() if e.budget)
+
+
+def replanned() -> tuple[str, ...]:
+    """Planners whose shorter plans are not prefixes of their longer ones: planned at every budget."""
+    return tuple(e.name for e in entries() if not e.prefixes)

@@ -4,7 +4,7 @@ Table 2 + rendering ablations + planner comparison (`nbv online`) on N nodes of 
 The per-run planning times come from `paper_results/online/online.json` and the Table 2 time from
 `paper_results/table2.json` (both measured on our 2-core machine); the other costs are measured
 figures passed as options (their defaults: what we measured, see the options' help). The prediction is
-`nbv.fanout.capacity.schedule_wall_s`: one core per unit, longest first.
+`nbv.bench.capacity.schedule_wall_s`: one core per unit, longest first.
 
     python scripts/capacity_plan.py --efficiency 0.9 --out docs/capacity.md
 """
@@ -17,15 +17,21 @@ from pathlib import Path
 
 from common.io import markdown_table, write_text
 from common.provenance import git_commit
-from nbv.fanout.capacity import schedule_wall_s
+from nbv.bench.capacity import schedule_wall_s
+from nbv.experiments.ablate import AblateConfig
+from nbv.experiments.ablation_axes import AXES, REFERENCE, units
 
 NODES = (1, 2, 4, 8)
 CORES = (2, 16, 64)
-ABLATION_BUILDINGS, ABLATION_SEEDS = 2, 3
-"""`nbv ablate`'s default run: the two Table 2 buildings, seeds 0 1 2."""
-ABLATION_LEVELS, ABLATION_LIGHTING_LEVELS = 29, 6
-"""Units per building and seed of `nbv ablate`'s default run: the reference and 28 levels of 13 axes; the
-lighting ones (and the reference) also plan greedily."""
+
+
+def ablation_units(config: AblateConfig = AblateConfig()) -> tuple[int, int]:
+    """Units of an `nbv ablate` run (by default its default run: the Table 2 buildings x seeds, the
+    reference and every level of every axis), and how many of them also plan greedily (the reference
+    and the lighting axes' levels)."""
+    run = units(config)
+    lighting = [unit for unit in run if unit.axis == REFERENCE or AXES[unit.axis].lighting]
+    return len(run), len(lighting)
 
 
 def plan_units(online: dict, fixed_s: float) -> list[float]:
@@ -40,11 +46,10 @@ def experiments(args: argparse.Namespace) -> dict[str, list[list[float]]]:
     online = json.loads(Path(args.online).read_text())
     table2 = json.loads(Path(args.table2).read_text())
     buildings = len(table2["config"]["scenes"])
-    per_seed = ([args.ablation_lighting_s] * ABLATION_LIGHTING_LEVELS
-                + [args.ablation_s] * (ABLATION_LEVELS - ABLATION_LIGHTING_LEVELS))
+    count, lighting = ablation_units()
     return {
         "Table 2": [[table2["seconds"] / buildings] * buildings],
-        "ablations": [per_seed * ABLATION_BUILDINGS * ABLATION_SEEDS],
+        "ablations": [[args.ablation_lighting_s] * lighting + [args.ablation_s] * (count - lighting)],
         PLANNERS: [[args.reference_s] * len(online["budget"]), plan_units(online, args.plan_fixed_s)],
     }
 
@@ -132,7 +137,7 @@ COMMAND = ("python scripts/capacity_plan.py --plan-fixed-s {args.plan_fixed_s:g}
            "--bench {args.bench} --out docs/capacity.md")
 TEMPLATE = """# Capacity plan: the paper's experiments beyond one machine
 
-Written by `{command}` at commit {commit}; the schedule is `nbv.fanout.capacity.schedule_wall_s`.
+Written by `{command}` at commit {commit}; the schedule is `nbv.bench.capacity.schedule_wall_s`.
 
 ## Units of work and what one costs
 
@@ -161,9 +166,9 @@ units, and the efficiency above on every node.
 
 ## The fan-out measured here (`make bench`, area fanout)
 
-The same 8 small plan units in this process, on 1 and 2 spawned local workers and on 2 Ray workers
-of a local instance, start-up included; every executor's numbers are checked against the in-process
-ones.
+The same 8 plan units of `make tables`' size (13 views at 320x240, TSDF and metrics) in this
+process, on 2 spawned local workers and on 2 Ray workers of a local instance, each pool started once
+and its start-up included; every executor's numbers are checked against the in-process ones.
 
 {bench}
 {verdict}

@@ -7,7 +7,7 @@ import itertools
 import numpy as np
 import pytest
 
-from nbv.fanout.capacity import schedule_wall_s
+from nbv.bench.capacity import schedule_wall_s
 
 
 def optimal_wall(costs: list[float], slots: int) -> float:

@@ -1,7 +1,8 @@
 """Fan-out figures (`nbv.fanout`): the same plan units in this process, on 2 local workers, on 2 Ray workers.
 
-The units are `nbv compare`'s plan runs at the size `make tables` runs them: the
-random and circle planners x 4 seeds on a preset building, 13 views at 320x240
+The units are a planner study's plan runs (`nbv.experiments.planner_study`,
+what `nbv compare` runs) at the size `make tables` runs them: the random and
+circle planners x 4 seeds on a preset building, 13 views at 320x240
 with the default render, TSDF and metric settings, scored against the
 ground-truth mesh given as the reference (so no full scan is rendered inside
 the timing). Each executor runs all of them into its own fresh folder, timed
@@ -27,15 +28,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from nbv.bench import BenchResult
-from nbv.experiments.compare import CompareConfig, comparison_tasks
+from nbv.experiments.planner_study import PlannerStudy, plan_units, study_stages
 from nbv.fanout.config import ExecutorConfig
 from nbv.fanout.executor import run_stages, start_workers
-from nbv.fanout.task import Task
+from nbv.planning.config import PlanSettings
 from nbv.recon.config import MetricsConfig, ReconstructionConfig
 from render.camera import UAVCamera
 from render.settings import RenderSettings
 from scenes import load_scene
-from scenes.spec import SceneSpec
 
 PLANNERS = ("random", "circle")
 """The planners of the benchmarked units (cheap to decide: the time goes to rendering, fusing, scoring)."""
@@ -73,29 +73,25 @@ QUICK = Size("test_building", (0, 1), 4, UAVCamera(96, 72), RenderSettings(spp=1
 """`nbv bench --quick`: 4 tiny units, to check the bench runs."""
 
 
-def comparison(size: Size, out: Path, reference: Path, seeds: tuple[int, ...]) -> CompareConfig:
-    """The benchmarked comparison of `seeds` into `out`, scored against `reference`."""
-    return CompareConfig(scene=SceneSpec(scene=size.scene), planners=PLANNERS, seeds=seeds, views=size.views,
-                         camera=size.camera, render=size.render, metrics=size.metrics, recon=size.recon,
-                         reference=reference, out=out)
+def comparison(size: Size, out: Path, reference: Path, seeds: tuple[int, ...]) -> PlannerStudy:
+    """The benchmarked planner study of `seeds` into `out`, scored against `reference`."""
+    settings = PlanSettings(camera=size.camera, render=size.render, metrics=size.metrics, recon=size.recon,
+                            reference=reference)
+    return PlannerStudy(scenes=(size.scene,), planners=PLANNERS, seeds=seeds, budgets=(size.views,),
+                        settings=settings, out=out)
 
 
-def plan_units(config: CompareConfig) -> list[list[Task]]:
-    """The comparison's units in their stages (the only tie to the study driver)."""
-    return list(comparison_tasks(config))
-
-
-def numbers(config: CompareConfig) -> list[dict]:
+def numbers(study: PlannerStudy) -> list[dict]:
     """Every unit's viewpoints and metrics, read back from its plan.json."""
-    docs = [json.loads(task.result.read_text()) for task in plan_units(config)[-1]]
+    docs = [json.loads(task.result.read_text()) for task in plan_units(study)]
     return [{k: doc[k] for k in ("viewpoints", "gt", "reference")} for doc in docs]
 
 
-def timed(executor: ExecutorConfig, config: CompareConfig) -> float:
-    """Wall seconds from starting `executor`'s workers to the last of `config`'s units done."""
+def timed(executor: ExecutorConfig, study: PlannerStudy) -> float:
+    """Wall seconds from starting `executor`'s workers to the last of `study`'s units done."""
     start = time.perf_counter()
     start_workers(executor)
-    run_stages(plan_units(config), executor)
+    run_stages(study_stages(study), executor)
     return time.perf_counter() - start
 
 
@@ -108,7 +104,7 @@ def run(quick: bool) -> list[BenchResult]:
         root = Path(scratch)
         reference = root / "reference.ply"
         load_scene(size.scene).target_mesh().export(reference)
-        run_stages(plan_units(comparison(size, root / "warm-up", reference, (99,))))
+        run_stages(study_stages(comparison(size, root / "warm-up", reference, (99,))))
         for name, executor in EXECUTORS.items():
             config = comparison(size, root / name.replace(" ", "_"), reference, size.seeds)
             walls[name] = timed(executor, config)

@@ -1,6 +1,9 @@
-"""Shared fixtures: one per Mitsuba variant (skipped where the backend is missing), a private cache."""
+"""Shared fixtures: one per Mitsuba variant (skipped where the backend is missing), a private cache, and
+the fan-out's kept workers closed after each test module."""
 
 from __future__ import annotations
+
+import sys
 
 import pytest
 
@@ -24,3 +27,14 @@ def _private_cache(tmp_path_factory) -> None:
     mp.setenv("NBV_CACHE_DIR", str(tmp_path_factory.mktemp("nbv_cache")))
     yield
     mp.undo()
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _close_kept_workers():
+    """The fan-out keeps its local pools and its Ray connection for the process; a test module's are shut
+    down after it, so no module inherits another's workers (or finds Ray already connected)."""
+    yield
+    if "nbv.fanout.processes" in sys.modules:
+        sys.modules["nbv.fanout.processes"].close_pools()
+    if "nbv.fanout.ray_pool" in sys.modules:
+        sys.modules["nbv.fanout.ray_pool"].disconnect()

@@ -163,6 +163,7 @@ def test_unknown_scene_is_a_clear_cli_error(tmp_path, capsys):
 
 
 def test_training_on_a_lattice_renders_it_first_on_the_workers(tmp_path, monkeypatch):
+    import nbv.features.source
     import nbv.rl.env
     from nbv.rl.lattice import lattice_path
     from render.variant import select_variant
@@ -179,7 +180,7 @@ def test_training_on_a_lattice_renders_it_first_on_the_workers(tmp_path, monkeyp
         pytest.fail("the training env built a renderer: the workers had cached the lattice")
 
     monkeypatch.setattr(nbv.rl.env, "build_lattice", cached_already)
-    monkeypatch.setattr(nbv.rl.env, "MitsubaRenderer", rendered)  # no renderer, so nothing rendered
+    monkeypatch.setattr(nbv.features.source, "MitsubaRenderer", rendered)  # no renderer, so nothing rendered
     args = ["train", *TINY_ENV, "--lattice", "--lattice-radii", "1", "--lattice-azimuths", "4",
             "--lattice-elevations", "2", "--frames", "2", "--frames-per-batch", "2", "--init-random-frames",
             "2", "--workers", "2", "--out", str(tmp_path / "run"), "--no-progress"]
@@ -209,7 +210,7 @@ def test_a_record_from_before_the_reward_group_reads_into_it():
 def test_shipped_records_read_into_the_reward_and_members_groups():
     from pathlib import Path
 
-    from nbv.planning.planners import SHIPPED_POLICY
+    from nbv.planning.registry import SHIPPED_POLICY
 
     config, _ = load_policy(SHIPPED_POLICY)
     raw = json.loads(torch.load(SHIPPED_POLICY, weights_only=True)["config"])

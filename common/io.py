@@ -86,13 +86,19 @@ def check_separate(out: str | Path, source: str | Path, may_hold: bool = False) 
 
 
 def _pid_alive(pid: int) -> bool:
+    """Whether process `pid` still runs: a killed worker its parent has not reaped yet (a zombie, which
+    signal 0 still reaches) is dead."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
     except PermissionError:
         return True
-    return True
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (OSError, IndexError):
+        return True
+    return state not in ("Z", "X")
 
 
 def recover_stale(out: str | Path) -> None:

@@ -84,12 +84,12 @@ def bench_verdict(path: str) -> str:
     load = figures["1-minute load average at the start (cores busy before the bench)"]
     two = figures["speed-up, 2 local workers, over in process"]
     if load < 1.0:
-        return (f"On idle cores 2 workers ran {two:.2f}x as fast as this process. In process a unit already "
-                "keeps both cores busy (Dr.Jit renders on every core, Open3D and the metrics use threads), "
-                "so that ratio is the efficiency per core of one-core workers against cores used in "
-                f"process: {min(two, 1.0):.2f}, the per-core scaling the plan above assumes. On 2 cores "
-                "fan-out therefore buys nothing over one process; it pays where the workers have cores "
-                "one process cannot use (more nodes).")
+        return (f"On idle cores 2 workers ran {two:.2f}x as fast as this process: an efficiency of "
+                f"{two / 2:.2f} to {min(two, 1.0):.2f} per core, the first if the in-process run used one "
+                "core, the second if it kept both busy. Dr.Jit renders on every core and Open3D and the "
+                "metrics use threads, so on 2 cores one process is already close to the second case: "
+                "fan-out buys little over one process there, and pays where the workers have cores one "
+                "process cannot use (more nodes).")
     return (f"The machine was busy (load average {load:.1f} on 2 cores before the bench, our processes "
             f"niced): the fan-out had less than one free core, so its {two:.2f}x measures start-up and "
             "contention, not the efficiency on a cluster's dedicated cores, which the table above "

@@ -42,6 +42,16 @@ class Viewpoint:
         return np.array([self.radius, self.azimuth, self.elevation])
 
 
+def draw_viewpoint(low: np.ndarray, high: np.ndarray, rng: np.random.Generator) -> Viewpoint:
+    """A viewpoint uniform between `low` and `high` (R, azimuth, elevation): one `rng.random(3)` draw.
+
+    Example:
+        >>> draw_viewpoint(np.array([1.0, 0.0, 0.0]), np.array([2.0, 1.0, 0.5]), np.random.default_rng(0))
+        Viewpoint(radius=1.6369616873214543, azimuth=0.2697867137638703, elevation=0.020486761968097345)
+    """
+    return Viewpoint(*map(float, low + rng.random(3) * (high - low)))
+
+
 def viewpoint_to_c2w(view: Viewpoint, center: np.ndarray) -> np.ndarray:
     """Camera-to-world (OpenCV) of a camera at `view` looking at `center`.
 

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from render.viewpoint import Viewpoint
+from render.viewpoint import Viewpoint, draw_viewpoint
 
 if TYPE_CHECKING:
     from nbv.planning.world import PlanningWorld
@@ -38,7 +38,7 @@ class Planner(ABC):
 def sample_viewpoints(low: np.ndarray, high: np.ndarray, count: int,
                       rng: np.random.Generator) -> list[Viewpoint]:
     """`count` viewpoints drawn uniformly between `low` and `high` (R, azimuth, elevation)."""
-    return [Viewpoint(*map(float, low + rng.random(3) * (high - low))) for _ in range(count)]
+    return [draw_viewpoint(low, high, rng) for _ in range(count)]
 
 
 def check_candidates(planner: str, candidates: int) -> int:

@@ -6,8 +6,8 @@ through the view source (`nbv.features.source.ViewSource`); the oracle reads
 the target's true mesh; the policy builds its own env on the same view source
 (`nbv.planning.policy`). The start viewpoint and the Bag of Views are those an
 `NBVEnv` on the same settings and seed starts its first episode with: the
-start drawn as `low + rng.random(3) * (high - low)` from
-`np.random.default_rng(seed)`, the bag made by the env config's `bov` with the
+start drawn by `render.viewpoint.draw_viewpoint` from
+`np.random.default_rng(seed)`, as the env draws it, the bag made by the env config's `bov` with the
 seed and the elevation bounds, so every planner starts where the env would.
 """
 
@@ -20,7 +20,7 @@ import numpy as np
 
 from nbv.bov.bag import BagOfViews
 from nbv.features.source import ViewSource
-from render.viewpoint import Viewpoint
+from render.viewpoint import draw_viewpoint
 
 if TYPE_CHECKING:
     from nbv.rl.config import EnvConfig
@@ -48,8 +48,7 @@ class PlanningWorld:
                                            self.seed)
         self.source.select(self.scene)
         rng = np.random.default_rng(self.seed)  # drawn as NBVEnv draws its first start
-        radius, azimuth, elevation = self.low + rng.random(3) * (self.high - self.low)
-        self.start = Viewpoint(float(radius), float(azimuth), float(elevation))
+        self.start = draw_viewpoint(self.low, self.high, rng)
 
     @property
     def target(self) -> Scene:

@@ -73,7 +73,7 @@ from nbv.features.source import ViewSource
 from nbv.recon.visibility import SurfaceVisibility, scene_visibility
 from nbv.rl.config import EnvConfig, RewardConfig
 from nbv.rl.lattice import ViewLattice, build_lattice
-from render.viewpoint import TWO_PI, Viewpoint, viewpoint_to_c2w
+from render.viewpoint import TWO_PI, Viewpoint, draw_viewpoint, viewpoint_to_c2w
 from scenes.model import Scene
 from scenes.spec import SceneSpec
 
@@ -197,8 +197,7 @@ class NBVEnv(EnvBase):
         self.source.select(self._scene)
         self._episode += 1
         low, high = self.config.low, self.config.high
-        radius, azimuth, elevation = low + self._rng.random(3) * (high - low)
-        self._view = Viewpoint(float(radius), float(azimuth), float(elevation))
+        self._view = draw_viewpoint(low, high, self._rng)
         self.bov.reset()
         frame, descriptors = self.capture(self._view)
         self.bov.update(descriptors, self._view.azimuth, self._view.elevation)

@@ -1,0 +1,6 @@
+"""Flight: the path a UAV flies through a plan's views, its metres and its turn-backs."""
+
+from nbv.flight.path import FlightPath, azimuth_step, shell_path, shell_position
+from nbv.flight.reversals import azimuth_reversals
+
+__all__ = ["FlightPath", "azimuth_reversals", "azimuth_step", "shell_path", "shell_position"]

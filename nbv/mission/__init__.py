@@ -1,7 +1,18 @@
-"""Missions out: a plan's views as a QGroundControl .plan or a KML for a real UAV (issue 27)."""
+"""Missions out: a plan's views as a QGroundControl .plan or a KML for a real UAV (issue 27).
 
-from nbv.mission.config import MissionConfig
-from nbv.mission.route import PlannedViews, Route, Waypoint, plan_route, read_plan
-from nbv.mission.write import write_mission
+Names are re-exported lazily (`common.lazy`), so importing the config module stays light.
+"""
 
-__all__ = ["MissionConfig", "PlannedViews", "Route", "Waypoint", "plan_route", "read_plan", "write_mission"]
+from common.lazy import lazy_exports
+
+_EXPORTS = {
+    "MissionConfig": "nbv.mission.config",
+    "PlannedViews": "nbv.mission.route",
+    "Route": "nbv.mission.route",
+    "Waypoint": "nbv.mission.route",
+    "plan_route": "nbv.mission.route",
+    "read_plan": "nbv.mission.route",
+    "write_mission": "nbv.mission.write",
+}
+__all__ = sorted(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -7,9 +7,10 @@ flat, at the take-off point's height. The legs between views follow the plan's
 flown path (`nbv.flight.shell_path`: along the viewing shell, clear of the target and the ground),
 sampled every `waypoint_spacing_m`, and never below the safety altitude. Ferries between the take-off
 point and the path fly at the safety altitude above the target's top, so a ferry that crosses the
-target clears it; with the default take-off point (below the start view) the ferry out is a straight
-climb. Every view waypoint faces the target (heading to the footprint centre) with the gimbal pitched
-to minus the view's elevation.
+target clears it; with the default take-off point (below the start view, moved out beside the
+footprint when the start view looks down from above the roof) the ferry out is a straight climb.
+Every view waypoint faces the target (heading to the footprint centre) with the gimbal pitched to
+minus the view's elevation.
 """
 
 from __future__ import annotations
@@ -29,6 +30,9 @@ from render.viewpoint import Viewpoint
 
 SAME_M = 0.01
 """Positions closer than this (metres) are one waypoint."""
+
+TAKEOFF_CLEARANCE_M = 2.0
+"""Least distance (metres) from the target's footprint of the default take-off point."""
 
 
 @dataclass(frozen=True)
@@ -167,14 +171,35 @@ def _path_waypoints(points: np.ndarray, ends: set[int], planned: PlannedViews, t
 
 
 def _takeoff(config: MissionConfig, start: np.ndarray, bounds: np.ndarray) -> tuple[float, float]:
-    """Take-off point (east, north): the flags', or below the start view; refused inside the footprint."""
+    """Take-off point (east, north): the flags' (refused inside the target's footprint), or below the start
+    view, moved out along its azimuth to `TAKEOFF_CLEARANCE_M` beyond the footprint if it lies within."""
     if config.takeoff_lat is None:
-        return float(start[0]), float(start[1])
+        return _outside_footprint(start[:2], bounds)
     east, north = latlon_to_enu(config.takeoff_lat, config.takeoff_lon, config.lat, config.lon)
-    if bounds[0, 0] <= east <= bounds[1, 0] and bounds[0, 1] <= north <= bounds[1, 1]:
+    if _inside(np.array([east, north]), bounds, 0.0):
         raise ValueError(f"--takeoff-lat/--takeoff-lon lie {east:.1f} m east, {north:.1f} m north of the "
                          "target, inside its footprint: take off outside the building")
     return east, north
+
+
+def _inside(point: np.ndarray, bounds: np.ndarray, margin_m: float) -> bool:
+    """Whether (east, north) `point` lies within `margin_m` of the footprint of the (2, 3) `bounds`."""
+    return bool(np.all(point >= bounds[0, :2] - margin_m) and np.all(point <= bounds[1, :2] + margin_m))
+
+
+def _outside_footprint(point: np.ndarray, bounds: np.ndarray) -> tuple[float, float]:
+    """`point`, or if within `TAKEOFF_CLEARANCE_M` of the footprint, the first point outward from the
+    footprint's centre through it that is not (straight east if `point` is the centre)."""
+    if not _inside(point, bounds, TAKEOFF_CLEARANCE_M):
+        return float(point[0]), float(point[1])
+    centre = bounds[:, :2].mean(axis=0)
+    offset = point - centre
+    direction = offset / np.linalg.norm(offset) if np.linalg.norm(offset) > SAME_M else np.array([1.0, 0.0])
+    half = (bounds[1, :2] - bounds[0, :2]) / 2 + TAKEOFF_CLEARANCE_M
+    with np.errstate(divide="ignore"):
+        reach = float(np.min(np.where(np.abs(direction) > 1e-12, half / np.abs(direction), np.inf)))
+    out = centre + direction * (reach + SAME_M)
+    return float(out[0]), float(out[1])
 
 
 def _ferry(takeoff: tuple[float, float], end: np.ndarray, altitude_m: float) -> list[Waypoint]:

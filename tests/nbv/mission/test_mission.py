@@ -174,3 +174,14 @@ def test_missing_plan_json_and_an_existing_output_are_named(tmp_path, capsys):
     assert mission(tmp_path, "m.kml") == 0
     assert mission(tmp_path, "m.kml") == 2
     assert "exists: use --overwrite" in capsys.readouterr().err
+
+
+def test_a_start_view_over_the_roof_takes_off_beside_the_footprint(tmp_path):
+    write_plan(tmp_path / "plan", start=[1.5, 0.0, math.radians(85.0)])  # 2.6 m east: over the roof
+    assert mission(tmp_path, "m.plan") == 0
+    doc = json.loads((tmp_path / "m.plan").read_text())
+    home = doc["mission"]["plannedHomePosition"]
+    assert haversine_m(*home[:2], LAT, LON) == pytest.approx(SIZE * 0.5 + 2.0, abs=0.02)  # 2 m past the side
+    assert angle_gap(bearing_deg(LAT, LON, *home[:2]), 90.0) < 0.01
+    first = next(i for i in doc["mission"]["items"][1:] if i["command"] == 16)
+    assert first["params"][6] == pytest.approx(SIZE * 2 * CENTRE_Z + SAFETY)  # ferries over the roof

@@ -47,6 +47,13 @@ def test_a_raw_y_up_scene_file_as_gt_is_refused_and_normalised_it_evaluates(tmp_
     for doc in docs.values():  # 1 % larger than the truth: about 0.5 cm, plus the sampling's spacing
         assert doc["chamfer_cm"] < 2.0 and doc["coverage"] > 0.3
 
+    recon.apply_translation([3.0, 0.0, 0.0])  # normalised, but another place: not the flag's fault
+    recon.export(tmp_path / "moved.ply")
+    assert main(["evaluate", str(tmp_path / "moved.ply"), "--gt", str(raw), "--up-axis", "y",
+                 "--normalise-gt", "--out", str(tmp_path / "moved"), *POINTS]) == 2
+    err = capsys.readouterr().err
+    assert "bounding boxes do not overlap" in err and "The ground truth is normalised" in err
+
 
 def test_disjoint_bounds_are_refused_for_gt_and_reference(tmp_path, capsys):
     box = trimesh.creation.box((0.6, 0.4, 1.0))

@@ -9,8 +9,12 @@ from __future__ import annotations
 
 import importlib
 import sys
+from collections.abc import Sequence
 from typing import NamedTuple
 
+from common.errors import describe
+from common.io import check_out_path
+from common.locks import WAIT, lock_scope
 from nbv.fanout.task import WorkerDied
 
 
@@ -45,6 +49,15 @@ ERRORS = (ValueError, FileExistsError, FileNotFoundError, PermissionError, Worke
 """Exceptions reported in one line, exit status 2: the user's input at fault, or a unit of work whose
 worker died twice (it is named)."""
 
+WAIT_FLAG = "--wait-for-lock"
+"""Any command: wait for an output another run is writing instead of failing at once (`common.locks`)."""
+
+
+def out_values(args: Sequence[str]) -> list[str]:
+    """The values given to `--out` in `args` (`--out DIR` or `--out=DIR`)."""
+    values = [arg.partition("=")[2] for arg in args if arg.startswith("--out=")]
+    return values + [args[i + 1] for i, arg in enumerate(args[:-1]) if arg == "--out"]
+
 
 def usage() -> str:
     """The top-level help: every command with its one-line description."""
@@ -52,7 +65,8 @@ def usage() -> str:
     lines = ["usage: nbv COMMAND [OPTIONS]", "",
              "Appearance-based next-best-view planning toolkit (Bag of Views).", "", "commands:"]
     lines += [f"  {name:<{width}}  {command.help}" for name, command in COMMANDS.items()]
-    lines += ["", "`nbv COMMAND --help` lists a command's options."]
+    lines += ["", "`nbv COMMAND --help` lists a command's options.",
+              f"{WAIT_FLAG} (any command): wait for an output another run is writing, instead of failing."]
     return "\n".join(lines)
 
 
@@ -66,12 +80,20 @@ def main(argv: list[str] | None = None) -> int:
     if name not in COMMANDS:
         print(f"nbv: error: unknown command {name!r} (choose from {', '.join(COMMANDS)})", file=sys.stderr)
         return 2
+    WAIT[0] = WAIT_FLAG in rest
+    rest = [arg for arg in rest if arg != WAIT_FLAG]
     module = importlib.import_module(f"nbv.cli.{COMMANDS[name].module}")
     try:
-        return int(module.main(rest, prog=f"nbv {name}") or 0)
+        with lock_scope():
+            for out in out_values(rest):
+                check_out_path(out)
+            return int(module.main(rest, prog=f"nbv {name}") or 0)
     except ERRORS as err:
-        print(f"nbv {name}: error: {err}", file=sys.stderr)
+        print(f"nbv {name}: error: {describe(err) if isinstance(err, OSError) else err}", file=sys.stderr)
         return 2
+    except OSError as err:  # a full disk, an I/O error: what failed and where, in one line
+        print(f"nbv {name}: error: {describe(err)}", file=sys.stderr)
+        return 1
     except SystemExit as done:  # tyro's --help (0) and its messages about bad options (2)
         return 0 if done.code is None else done.code if isinstance(done.code, int) else 2
 

@@ -16,14 +16,15 @@ class WriteError(OSError):
     """An OSError raised while writing an output, naming the output's path."""
 
     def __str__(self) -> str:
-        return describe(self, "writing")
+        return describe(self)
 
 
-def describe(err: OSError, verb: str = "at") -> str:
-    """One line for an OSError: `no space left on device (ENOSPC) writing PATH`; its own message when it
-    carries no errno (a message written for the user)."""
+def describe(err: OSError) -> str:
+    """One line for an OSError: `no space left on device (ENOSPC) writing PATH` (`at PATH` when it is not
+    a WriteError); its own message when it carries no errno (a message written for the user)."""
     if err.errno is None:
         return str(err)
+    verb = "writing" if isinstance(err, WriteError) else "at"
     what = (err.strerror or os.strerror(err.errno)).strip()
     line = f"{what[:1].lower()}{what[1:]} ({errno.errorcode.get(err.errno, err.errno)})"
     return f"{line} {verb} {err.filename}" if err.filename else line

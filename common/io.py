@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any, NoReturn
 
 from common.errors import as_write_error, describe
-from common.locks import OutputBusy, claim, release
+from common.locks import OutputBusy, claim, lock_file, release, remove_if_free
 
 NAME_ROOM = 32
 """Bytes an output's name leaves free for the names written beside it (`.NAME.tmp-PID-XXXXXXXX`)."""
@@ -94,7 +94,7 @@ def check_out_path(out: str | Path) -> None:
 def _pathconf(path: Path, name: str, default: int) -> int:
     """`os.pathconf` of the nearest existing folder holding `path`."""
     folder = Path(os.path.abspath(path)).parent
-    while not folder.is_dir() and folder != folder.parent:
+    while not os.path.isdir(folder) and folder != folder.parent:  # os.path: no error on a long name
         folder = folder.parent
     try:
         return os.pathconf(folder, name)
@@ -188,12 +188,14 @@ def _pid_alive(pid: int) -> bool:
 
 
 def recover_stale(out: str | Path) -> None:
-    """Clean up after dead runs that wrote `out`: remove their `.NAME.tmp-PID-*` folders and their
-    `.NAME.old-PID` (the previous output moved aside for the swap), put back if `out` is missing."""
+    """Clean up after dead runs that wrote `out`: remove their `.NAME.tmp-PID-*` folders, their lock file
+    `.NAME.lock` and their `.NAME.old-PID` (the previous output moved aside for the swap), put back if
+    `out` is missing."""
     out = Path(out)
     if not out.parent.is_dir():
         return
     pattern = re.compile(rf"\.{re.escape(out.name)}\.(tmp|old)-(\d+)(-.*)?")
+    remove_if_free(lock_file(out))  # a SIGKILLed run's (the lock itself died with it)
     for entry in sorted(out.parent.iterdir(), key=lambda p: p.name):
         match = pattern.fullmatch(entry.name)
         if match is None or _pid_alive(int(match[2])):

@@ -71,6 +71,22 @@ def release(target: str | Path) -> None:
         os.close(fd)
 
 
+def remove_if_free(path: str | Path) -> None:
+    """Remove the lock file `path` if no process holds it (left by a SIGKILLed run); a waiter that
+    opened it meanwhile sees it gone and locks a new one."""
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CLOEXEC)
+    except OSError:
+        return
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        Path(path).unlink(missing_ok=True)
+    except OSError:
+        pass  # held: its run is alive
+    finally:
+        os.close(fd)
+
+
 def held() -> set[Path]:
     """The paths this process holds locks on."""
     return set(_HELD)

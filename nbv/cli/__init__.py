@@ -82,11 +82,11 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     WAIT[0] = WAIT_FLAG in rest
     rest = [arg for arg in rest if arg != WAIT_FLAG]
-    module = importlib.import_module(f"nbv.cli.{COMMANDS[name].module}")
     try:
         with lock_scope():
             for out in out_values(rest):
-                check_out_path(out)
+                check_out_path(out)  # before the command is even imported
+            module = importlib.import_module(f"nbv.cli.{COMMANDS[name].module}")
             return int(module.main(rest, prog=f"nbv {name}") or 0)
     except ERRORS as err:
         print(f"nbv {name}: error: {describe(err) if isinstance(err, OSError) else err}", file=sys.stderr)

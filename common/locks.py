@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import fcntl
 import os
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -47,7 +48,7 @@ def _acquire(target: Path, wait: bool) -> int:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | (0 if wait else fcntl.LOCK_NB))
         except BlockingIOError:
-            holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
+            holder = _holder(fd)
             os.close(fd)
             raise OutputBusy(f"{target} is being written by another run (pid {holder}); wait for it to "
                              "finish, or pass --wait-for-lock to wait") from None
@@ -60,6 +61,16 @@ def _acquire(target: Path, wait: bool) -> int:
             os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
             return fd
         os.close(fd)
+
+
+def _holder(fd: int) -> str:
+    """The pid in a held lock file (its holder writes it just after locking: give it a moment)."""
+    for _ in range(50):
+        text = os.pread(fd, 32, 0).decode(errors="replace").strip()
+        if text:
+            return text
+        time.sleep(0.002)
+    return "unknown"
 
 
 def release(target: str | Path) -> None:

@@ -8,13 +8,14 @@ parses its config with tyro (`nbv.cli.parse`) and calls the library.
 from __future__ import annotations
 
 import importlib
+import os
 import sys
 from collections.abc import Sequence
 from typing import NamedTuple
 
 from common.errors import describe
-from common.io import check_out_path
-from common.locks import WAIT, lock_scope
+from common.io import check_out_path, output_target
+from common.locks import WAIT, OutputBusy, claim, lock_scope
 from nbv.fanout.task import WorkerDied
 
 
@@ -59,6 +60,20 @@ def out_values(args: Sequence[str]) -> list[str]:
     return values + [args[i + 1] for i, arg in enumerate(args[:-1]) if arg == "--out"]
 
 
+def hold_output(out: str) -> None:
+    """Hold the lock of `--out` for the whole command (`common.locks`): a second run on it fails at once,
+    naming this one. Where no lock can be made, the command's own checks name the fault."""
+    target = output_target(out)
+    if not os.path.isdir(os.path.dirname(os.path.abspath(target))):
+        return  # made (and locked) by the command, once its checks passed
+    try:
+        claim(target)
+    except OutputBusy:
+        raise
+    except OSError:
+        pass
+
+
 def usage() -> str:
     """The top-level help: every command with its one-line description."""
     width = max(map(len, COMMANDS))
@@ -84,8 +99,9 @@ def main(argv: list[str] | None = None) -> int:
     rest = [arg for arg in rest if arg != WAIT_FLAG]
     try:
         with lock_scope():
-            for out in out_values(rest):
-                check_out_path(out)  # before the command is even imported
+            for out in out_values(rest):  # before the command is even imported
+                check_out_path(out)
+                hold_output(out)
             module = importlib.import_module(f"nbv.cli.{COMMANDS[name].module}")
             return int(module.main(rest, prog=f"nbv {name}") or 0)
     except ERRORS as err:

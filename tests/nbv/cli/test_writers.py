@@ -66,8 +66,8 @@ def test_two_scans_one_out_exactly_one_wins(tmp_path, capsys):
                               "--out", str(out)], env={**os.environ, "PYTHONPATH": str(ROOT)},
                              stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 120
-    while not lock_file(out).exists() and first.poll() is None and time.monotonic() < deadline:
-        time.sleep(0.005)  # the first run holds --out from its up-front check on
+    while first.poll() is None and time.monotonic() < deadline and not lock_file(out).exists():
+        time.sleep(0.005)  # the first run holds --out from its start on
     second = main([*SCAN, "--views", "2", "--seed", "7", "--out", str(out)])
     err = one_line(capsys)
     assert first.wait() == 0, first.stderr.read()

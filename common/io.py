@@ -24,9 +24,7 @@ from typing import Any, NoReturn
 
 from common.errors import as_write_error, describe
 from common.locks import OutputBusy, claim, lock_file, release, remove_if_free
-
-NAME_ROOM = 32
-"""Bytes an output's name leaves free for the names written beside it (`.NAME.tmp-PID-XXXXXXXX`)."""
+from common.outpath import check_out_path
 
 
 @contextmanager
@@ -69,43 +67,6 @@ def current_umask() -> int:
     return mask
 
 
-def check_out_path(out: str | Path) -> None:
-    """Refuse (ValueError naming it) an output path that is empty, too long for the file system
-    (ENAMETOOLONG) or a symlink to nothing."""
-    text = os.fspath(out)
-    if not text.strip():
-        raise ValueError("--out is empty: name the output folder (e.g. --out runs/scan1)")
-    parts = Path(text).parts
-    name_max = _pathconf(Path(text), "PC_NAME_MAX", 255)
-    for i, part in enumerate(parts):
-        limit = name_max - (NAME_ROOM if i == len(parts) - 1 else 0)
-        if len(os.fsencode(part)) > limit:
-            raise ValueError(f"output {_short(text)}: file name too long (ENAMETOOLONG): a part of "
-                             f"{len(os.fsencode(part))} bytes, at most {limit}; use a shorter name")
-    limit = _pathconf(Path(text), "PC_PATH_MAX", 4096) - name_max
-    if len(os.fsencode(os.path.abspath(text))) > limit:
-        raise ValueError(f"output {_short(text)}: path too long (ENAMETOOLONG): "
-                         f"{len(os.fsencode(os.path.abspath(text)))} bytes, at most {limit}")
-    if os.path.islink(text) and not os.path.exists(text):
-        raise FileNotFoundError(f"output {text} is a symlink to {os.readlink(text)}, which does not exist "
-                                "(remove the link or create its target)")
-
-
-def _pathconf(path: Path, name: str, default: int) -> int:
-    """`os.pathconf` of the nearest existing folder holding `path`."""
-    folder = Path(os.path.abspath(path)).parent
-    while not os.path.isdir(folder) and folder != folder.parent:  # os.path: no error on a long name
-        folder = folder.parent
-    try:
-        return os.pathconf(folder, name)
-    except (OSError, ValueError):
-        return default
-
-
-def _short(text: str) -> str:
-    return text if len(text) <= 80 else f"{text[:60]}...({len(text)} characters)"
-
-
 def output_target(out: str | Path) -> Path:
     """Where `out` is written: its target when `out` is a symlink (the link is kept), else `out`."""
     out = Path(out)
@@ -134,7 +95,7 @@ def check_output_folder(out: Path, overwrite: bool, outputs: tuple[str, ...] | N
     if not os.access(parent, os.W_OK | os.X_OK):
         raise PermissionError(f"output folder {out} is not writable (no write access to {parent})")
     try:
-        claim(target)
+        claim(target, wait=True if in_cache(target) else None)  # a cache entry: its writer's result will do
     except OutputBusy:
         raise
     except OSError as err:  # e.g. /proc passes the checks above but takes no lock file
@@ -343,9 +304,18 @@ def write_json(path: str | Path, doc: Any) -> Path:
 
 def cache_dir() -> Path:
     """The cache root: `$NBV_CACHE_DIR` if set and not empty, else `~/.cache/nbv`; created on demand."""
-    root = Path(os.environ.get("NBV_CACHE_DIR") or Path.home() / ".cache" / "nbv")
+    root = _cache_root()
     root.mkdir(parents=True, exist_ok=True)
     return root
+
+
+def _cache_root() -> Path:
+    return Path(os.environ.get("NBV_CACHE_DIR") or Path.home() / ".cache" / "nbv")
+
+
+def in_cache(path: str | Path) -> bool:
+    """Whether `path` lies in the cache root (`cache_dir`)."""
+    return Path(os.path.realpath(_cache_root())) in Path(os.path.realpath(path)).parents
 
 
 def write_cache(path: str | Path, write: Callable[[Path], None]) -> bool:

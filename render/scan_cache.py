@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from common.errors import describe
-from common.io import cache_dir
+from common.io import cache_dir, in_cache
 from common.locks import claim, release
 from render.camera import UAVCamera
 from render.capture import capture_dataset
@@ -70,7 +70,7 @@ def ensure_scan(scene: Scene, camera: UAVCamera, viewpoints: Sequence[Viewpoint]
             capture_dataset(scene, camera, viewpoints, folder, settings, meta, overwrite=True,
                             progress=progress)
     except OSError as err:
-        if not entry.resolve().is_relative_to(cache_dir().resolve()):
+        if not in_cache(entry):
             raise
         warnings.warn(f"scan cache {folder} not written ({describe(err)}); rendering into a temporary "
                       "folder instead", stacklevel=2)

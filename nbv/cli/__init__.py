@@ -14,8 +14,9 @@ from collections.abc import Sequence
 from typing import NamedTuple
 
 from common.errors import describe
-from common.io import check_out_path, output_target
+from common.io import output_target
 from common.locks import WAIT, OutputBusy, claim, lock_scope
+from common.outpath import check_out_path
 from nbv.fanout.task import WorkerDied
 
 

@@ -57,8 +57,11 @@ def _acquire(target: Path, wait: bool) -> int:
         except FileNotFoundError:
             current = False
         if current:  # else its holder removed it on release between our open and our lock
-            os.ftruncate(fd, 0)
-            os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+            try:
+                os.ftruncate(fd, 0)
+                os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+            except OSError:
+                pass  # a full disk: the lock holds without the pid (a refused run says "pid unknown")
             return fd
         os.close(fd)
 

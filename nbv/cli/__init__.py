@@ -55,10 +55,23 @@ WAIT_FLAG = "--wait-for-lock"
 """Any command: wait for an output another run is writing instead of failing at once (`common.locks`)."""
 
 
-def out_values(args: Sequence[str]) -> list[str]:
-    """The values given to `--out` in `args` (`--out DIR` or `--out=DIR`)."""
-    values = [arg.partition("=")[2] for arg in args if arg.startswith("--out=")]
-    return values + [args[i + 1] for i, arg in enumerate(args[:-1]) if arg == "--out"]
+def flag_values(args: Sequence[str], flag: str) -> list[str]:
+    """The values given to `flag` in `args` (`--out DIR` or `--out=DIR`)."""
+    values = [arg.partition("=")[2] for arg in args if arg.startswith(f"{flag}=")]
+    return values + [args[i + 1] for i, arg in enumerate(args[:-1]) if arg == flag]
+
+
+def check_early(args: Sequence[str]) -> None:
+    """Before the command is even imported: every `--out` is checked and locked (`hold_output`), every
+    `--ray HOST:PORT` must answer."""
+    for out in flag_values(args, "--out"):
+        check_out_path(out)
+        hold_output(out)
+    for address in flag_values(args, "--ray"):
+        if address.strip() != "auto":
+            from nbv.fanout.ray_pool import check_reachable
+
+            check_reachable(address)
 
 
 def hold_output(out: str) -> None:
@@ -100,9 +113,7 @@ def main(argv: list[str] | None = None) -> int:
     rest = [arg for arg in rest if arg != WAIT_FLAG]
     try:
         with lock_scope():
-            for out in out_values(rest):  # before the command is even imported
-                check_out_path(out)
-                hold_output(out)
+            check_early(rest)
             module = importlib.import_module(f"nbv.cli.{COMMANDS[name].module}")
             return int(module.main(rest, prog=f"nbv {name}") or 0)
     except ERRORS as err:

@@ -214,11 +214,14 @@ def test_out_that_is_the_current_folder_is_refused(dataset, tmp_path, capsys, mo
     assert sorted(p.name for p in tmp_path.iterdir()) == []
 
 
-def test_ray_address_with_nothing_listening_fails_within_seconds():
+def test_ray_address_with_nothing_listening_fails_within_seconds(tmp_path, capsys):
     with socket.socket() as probe:  # a local port nothing listens on
         probe.bind(("127.0.0.1", 0))
         port = probe.getsockname()[1]
     start = time.monotonic()
+    assert main(["train", "--ray", f"127.0.0.1:{port}", "--out", str(tmp_path / "run")]) == 2  # before any work
+    assert one_line(capsys).startswith(f"nbv train: error: ray 127.0.0.1:{port}: nothing answers")
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
     with pytest.raises(ValueError, match=rf"^ray 127.0.0.1:{port}: nothing answers at 127.0.0.1:{port} "
                                          r"within 5 s \(connection refused \(ECONNREFUSED\)"):
         check_reachable(f"127.0.0.1:{port}")

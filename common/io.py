@@ -5,6 +5,10 @@ holds the process id, so two runs never share one) and renamed into place,
 so a reader sees the old file or the new one, never half of one. A command's
 output folder is written the same way (`atomic_folder`), and the temporary
 folders of a run that died are cleaned up by the next run writing that folder.
+One run writes an output at a time: its lock (`common.locks`) is held from the
+up-front check to the swap, and a run without overwrite never replaces an output
+that appeared meanwhile. An OSError while writing names the output's path, not the
+temporary one (`common.errors.WriteError`); a cache write that fails only warns.
 """
 
 from __future__ import annotations

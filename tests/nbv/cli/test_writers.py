@@ -219,7 +219,8 @@ def test_ray_address_with_nothing_listening_fails_within_seconds(tmp_path, capsy
         probe.bind(("127.0.0.1", 0))
         port = probe.getsockname()[1]
     start = time.monotonic()
-    assert main(["train", "--ray", f"127.0.0.1:{port}", "--out", str(tmp_path / "run")]) == 2  # before any work
+    train = ["train", "--ray", f"127.0.0.1:{port}", "--out", str(tmp_path / "run")]
+    assert main(train) == 2  # before any work
     assert one_line(capsys).startswith(f"nbv train: error: ray 127.0.0.1:{port}: nothing answers")
     assert sorted(p.name for p in tmp_path.iterdir()) == []
     with pytest.raises(ValueError, match=rf"^ray 127.0.0.1:{port}: nothing answers at 127.0.0.1:{port} "

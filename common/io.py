@@ -5,6 +5,10 @@ holds the process id, so two runs never share one) and renamed into place,
 so a reader sees the old file or the new one, never half of one. A command's
 output folder is written the same way (`atomic_folder`), and the temporary
 folders of a run that died are cleaned up by the next run writing that folder.
+One run writes an output at a time: its lock (`common.locks`) is held from the
+up-front check to the swap, and a run without overwrite never replaces an output
+that appeared meanwhile. An OSError while writing names the output's path, not the
+temporary one (`common.errors.WriteError`); a cache write that fails only warns.
 """
 
 from __future__ import annotations
@@ -16,10 +20,15 @@ import os
 import re
 import shutil
 import tempfile
-from collections.abc import Iterator, Sequence
+import warnings
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
+
+from common.errors import as_write_error, describe
+from common.locks import OutputBusy, claim, lock_file, release, remove_if_free
+from common.outpath import check_out_path
 
 
 @contextmanager
@@ -41,8 +50,18 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     try:
         yield tmp
         tmp.replace(path)
+    except OSError as err:
+        _reraise_as_write_error(err, tmp, path)
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def _reraise_as_write_error(err: OSError, tmp: Path, out: Path) -> NoReturn:
+    """Raise `err` as a WriteError naming the path under `out` written as `tmp` (`common.errors`)."""
+    named = as_write_error(err, tmp, out)
+    if named is err:
+        raise err
+    raise named from err
 
 
 def current_umask() -> int:
@@ -52,27 +71,59 @@ def current_umask() -> int:
     return mask
 
 
+def output_target(out: str | Path) -> Path:
+    """Where `out` is written: its target when `out` is a symlink (the link is kept), else `out`."""
+    out = Path(out)
+    return Path(os.path.realpath(out)) if out.is_symlink() else out
+
+
 def check_output_folder(out: Path, overwrite: bool, outputs: tuple[str, ...] | None = None) -> None:
-    """Fail early, naming the folder, if `out` cannot be written or would lose existing data.
+    """Fail early, naming the folder, if `out` cannot be written or would lose existing data; then hold
+    its lock (`common.locks`: a second run on `out` fails at once, naming this one) until the swap.
 
     `outputs`: the names the command writes into `out` (other entries are kept); None: the whole folder.
     """
-    out = Path(out)
-    recover_stale(out)
-    if out.exists() and not out.is_dir():
+    check_out_path(out)
+    out, target = Path(out), output_target(out)
+    cwd = Path.cwd().resolve()
+    if target.resolve() == cwd or target.resolve() in cwd.parents:
+        raise ValueError(f"output folder {out} is the current folder or holds it; name a new folder "
+                         f"(e.g. --out {out / 'run'})")
+    if target.exists() and not target.is_dir():
         raise FileExistsError(f"output {out} exists and is not a folder")
-    if outputs is None:
-        if out.is_dir() and any(out.iterdir()) and not overwrite:
-            raise FileExistsError(f"output folder {out} exists and is not empty (use --overwrite)")
-    elif not overwrite and (existing := [name for name in outputs if (out / name).exists()]):
-        raise FileExistsError(f"{out} already holds {', '.join(existing)} (use --overwrite)")
-    parent = out.parent
+    parent = target.parent
     while not parent.exists():
         parent = parent.parent
     if not parent.is_dir():
         raise FileNotFoundError(f"output folder {out} cannot be made: {parent} is a file, not a folder")
     if not os.access(parent, os.W_OK | os.X_OK):
         raise PermissionError(f"output folder {out} is not writable (no write access to {parent})")
+    try:
+        claim(target, wait=True if in_cache(target) else None)  # a cache entry: its writer's result will do
+    except OutputBusy:
+        raise
+    except OSError as err:  # e.g. /proc passes the checks above but takes no lock file
+        raise PermissionError(f"output folder {out} cannot be made: {describe(err)}") from None
+    recover_stale(target)
+    try:
+        check_not_replaced(out, target, overwrite, outputs)
+    except FileExistsError:
+        release(target)
+        raise
+
+
+def check_not_replaced(out: Path, target: Path, overwrite: bool, outputs: tuple[str, ...] | None,
+                       late: bool = False) -> None:
+    """Without `overwrite`, FileExistsError naming `out` when writing it would replace output (`late`:
+    output that appeared while this run ran)."""
+    when = " (it appeared while this run ran; nothing was replaced)" if late else ""
+    if overwrite:
+        return
+    if outputs is None:
+        if target.is_dir() and any(target.iterdir()):
+            raise FileExistsError(f"output folder {out} exists and is not empty{when} (use --overwrite)")
+    elif existing := [name for name in outputs if (target / name).exists()]:
+        raise FileExistsError(f"{out} already holds {', '.join(existing)}{when} (use --overwrite)")
 
 
 def check_separate(out: str | Path, source: str | Path, may_hold: bool = False) -> None:
@@ -102,12 +153,14 @@ def _pid_alive(pid: int) -> bool:
 
 
 def recover_stale(out: str | Path) -> None:
-    """Clean up after dead runs that wrote `out`: remove their `.NAME.tmp-PID-*` folders and their
-    `.NAME.old-PID` (the previous output moved aside for the swap), put back if `out` is missing."""
+    """Clean up after dead runs that wrote `out`: remove their `.NAME.tmp-PID-*` folders, their lock file
+    `.NAME.lock` and their `.NAME.old-PID` (the previous output moved aside for the swap), put back if
+    `out` is missing."""
     out = Path(out)
     if not out.parent.is_dir():
         return
     pattern = re.compile(rf"\.{re.escape(out.name)}\.(tmp|old)-(\d+)(-.*)?")
+    remove_if_free(lock_file(out))  # a SIGKILLed run's (the lock itself died with it)
     for entry in sorted(out.parent.iterdir(), key=lambda p: p.name):
         match = pattern.fullmatch(entry.name)
         if match is None or _pid_alive(int(match[2])):
@@ -120,13 +173,13 @@ def recover_stale(out: str | Path) -> None:
             entry.unlink(missing_ok=True)
 
 
-def _exchange(a: Path, b: Path) -> bool:
-    """Swap two existing paths in one step (Linux `renameat2` RENAME_EXCHANGE); False where unsupported."""
+def _renameat2(a: Path, b: Path, flag: int) -> bool:
+    """Linux `renameat2` with `flag` (1: fail if `b` exists, 2: swap the two); False where unsupported."""
     renameat2 = getattr(ctypes.CDLL(None, use_errno=True), "renameat2", None)
     if renameat2 is None:
         return False
-    at_fdcwd, rename_exchange = -100, 2
-    if renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange) == 0:
+    at_fdcwd = -100
+    if renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), flag) == 0:
         return True
     code = ctypes.get_errno()
     if code in (errno.EINVAL, errno.ENOSYS, errno.EOPNOTSUPP, errno.EPERM):
@@ -134,9 +187,22 @@ def _exchange(a: Path, b: Path) -> bool:
     raise OSError(code, os.strerror(code), str(b))
 
 
-def replace_folder(src: Path, dst: Path) -> None:
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two existing paths in one step (Linux `renameat2` RENAME_EXCHANGE); False where unsupported."""
+    return _renameat2(a, b, 2)
+
+
+def replace_folder(src: Path, dst: Path, replace: bool = True) -> None:
     """Move the finished folder `src` onto `dst`: in one exchange where the OS offers it, else the old `dst`
-    is moved aside, removed only once `src` is in place, and put back if the swap fails or is interrupted."""
+    is moved aside, removed only once `src` is in place, and put back if the swap fails or is interrupted.
+    Without `replace`, a `dst` that exists by then (not an empty folder) is left alone: FileExistsError."""
+    if not replace and not dst.exists():
+        try:
+            if _renameat2(src, dst, 1):
+                return
+        except FileExistsError:
+            raise FileExistsError(f"output folder {dst} appeared while this run ran; nothing was "
+                                  "replaced (use --overwrite)") from None
     if dst.is_dir() and not dst.is_symlink() and _exchange(src, dst):
         shutil.rmtree(src, ignore_errors=True)  # src now holds the old output
         return
@@ -194,11 +260,19 @@ def atomic_folder(out: str | Path, overwrite: bool = False,
     """
     out = Path(out)
     check_output_folder(out, overwrite, outputs)
-    with scratch_folder(out) as tmp:
-        if outputs is not None and out.is_dir():
-            _carry(out, tmp, outputs)
-        yield tmp
-        replace_folder(tmp, out)
+    target = output_target(out)
+    try:
+        with scratch_folder(target) as tmp:
+            try:
+                yield tmp
+                check_not_replaced(out, target, overwrite, outputs, late=True)
+                if outputs is not None and target.is_dir():  # at the swap: what is in `out` now is kept
+                    _carry(target, tmp, (*outputs, *(p.name for p in tmp.iterdir())))
+                replace_folder(tmp, target, replace=overwrite)
+            except OSError as err:
+                _reraise_as_write_error(err, tmp, out)
+    finally:
+        release(target)
 
 
 @contextmanager
@@ -234,9 +308,43 @@ def write_json(path: str | Path, doc: Any) -> Path:
 
 def cache_dir() -> Path:
     """The cache root: `$NBV_CACHE_DIR` if set and not empty, else `~/.cache/nbv`; created on demand."""
-    root = Path(os.environ.get("NBV_CACHE_DIR") or Path.home() / ".cache" / "nbv")
+    root = _cache_root()
     root.mkdir(parents=True, exist_ok=True)
     return root
+
+
+def _cache_root() -> Path:
+    return Path(os.environ.get("NBV_CACHE_DIR") or Path.home() / ".cache" / "nbv")
+
+
+def in_cache(path: str | Path) -> bool:
+    """Whether `path` lies in the cache root (`cache_dir`)."""
+    return Path(os.path.realpath(_cache_root())) in Path(os.path.realpath(path)).parents
+
+
+def write_cache(path: str | Path, write: Callable[[Path], None]) -> bool:
+    """Write the cache file `path` atomically with `write(tmp)`, holding its lock; skipped when another run
+    is writing it. A failing write (a full disk) is only a warning: a cache saves time, nothing more.
+    Returns whether the entry was written."""
+    path = Path(path)
+    try:
+        claim(path, wait=False)
+    except OutputBusy:
+        return False  # another run writes this very entry
+    except OSError as err:
+        warnings.warn(f"cache {path} not written ({describe(err)}); going on without it", stacklevel=2)
+        return False
+    try:
+        with atomic_path(path) as tmp:
+            write(tmp)
+        return True
+    except Exception as err:  # noqa: BLE001 - torch.save reports a full disk as RuntimeError
+        why = describe(err) if isinstance(err, OSError) else f"{type(err).__name__}: {str(err).strip()}"
+        warnings.warn(f"cache {path} not written ({why.splitlines()[0] if why else ''}); going on without it",
+                      stacklevel=2)
+        return False
+    finally:
+        release(path)
 
 
 def markdown_table(header: Sequence[str], rows: Sequence[Sequence[Any]]) -> str:

@@ -24,7 +24,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 from tyro.conf import Positional, arg
 
-from common.io import atomic_folder
+from common.io import atomic_folder, check_separate
 from render.dataset import ViewDataset, check_output_folder, read_dataset
 
 PINHOLE_MODEL_ID = 1
@@ -94,6 +94,7 @@ def export_dataset(config: ExportConfig) -> Path:
     source = Path(config.dataset).resolve()
     if out.resolve() == source or out.resolve() in source.parents:
         raise ValueError(f"output folder {out} would replace the dataset {config.dataset} it exports")
+    check_separate(out, config.dataset)  # an export inside the dataset would become part of it
     dataset = read_dataset(config.dataset)
     model = build_model(dataset, config.points_per_view if config.points else 0, config.seed)
     with atomic_folder(out, config.overwrite) as tmp:

@@ -10,6 +10,7 @@ beside the target, renamed into place only when complete.
 
 from __future__ import annotations
 
+import errno
 from collections.abc import Iterator
 from contextlib import ExitStack
 from dataclasses import dataclass, field
@@ -153,7 +154,9 @@ class DatasetWriter:
         pose = validate_pose(c2w, f"frame {len(self._frames)} pose")
         name = f"{len(self._frames):04d}.png"
         Image.fromarray(rgb).save(self._tmp / "images" / name)
-        cv2.imwrite(str(self._tmp / "depth" / name), depth_to_png(depth))
+        depth_file = self._tmp / "depth" / name
+        if not cv2.imwrite(str(depth_file), depth_to_png(depth)):  # cv2 returns False, never raises
+            raise OSError(errno.EIO, "the depth image could not be written", str(depth_file))
         frame_meta = dict(meta or {})
         if viewpoint is not None:
             frame_meta["viewpoint"] = viewpoint.as_array().tolist()

@@ -8,15 +8,21 @@ re-run cheaply and never reuse a stale scan.
 
 from __future__ import annotations
 
+import atexit
 import hashlib
 import json
+import shutil
+import tempfile
+import warnings
 from collections.abc import Sequence
 from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
 
-from common.io import cache_dir
+from common.errors import describe
+from common.io import cache_dir, in_cache
+from common.locks import claim, release
 from render.camera import UAVCamera
 from render.capture import capture_dataset
 from render.dataset import DatasetError, ViewDataset, read_dataset
@@ -51,12 +57,28 @@ def scan_key(scene: Scene, camera: UAVCamera, viewpoints: Sequence[Viewpoint], s
 def ensure_scan(scene: Scene, camera: UAVCamera, viewpoints: Sequence[Viewpoint], folder: str | Path,
                 settings: RenderSettings = RenderSettings(), meta: dict | None = None, fresh: bool = False,
                 progress: bool = True) -> ViewDataset:
-    """The scan of `viewpoints` at `folder`, rendered now unless an identical one is already there."""
+    """The scan of `viewpoints` at `folder`, rendered now unless an identical one is already there.
+
+    A run rendering the same folder is waited for (its scan is then reused); where the folder cannot be
+    written (a full disk), a warning, and the scan is rendered into a temporary folder instead."""
     folder = Path(folder)
     key = scan_key(scene, camera, viewpoints, settings, select_variant(settings.variant).variant())
-    if fresh or _stored_key(folder) != json.loads(json.dumps(key)):
-        capture_dataset(scene, camera, viewpoints, folder, settings, {**(meta or {}), "scan_key": key},
-                        overwrite=True, progress=progress)
+    meta, entry = {**(meta or {}), "scan_key": key}, folder
+    try:
+        claim(entry, wait=True)
+        if fresh or _stored_key(folder) != json.loads(json.dumps(key)):
+            capture_dataset(scene, camera, viewpoints, folder, settings, meta, overwrite=True,
+                            progress=progress)
+    except OSError as err:
+        if not in_cache(entry):
+            raise
+        warnings.warn(f"scan cache {folder} not written ({describe(err)}); rendering into a temporary "
+                      "folder instead", stacklevel=2)
+        folder = Path(tempfile.mkdtemp(prefix="nbv-scan-")) / folder.name
+        atexit.register(shutil.rmtree, folder.parent, True)
+        capture_dataset(scene, camera, viewpoints, folder, settings, meta, overwrite=True, progress=progress)
+    finally:
+        release(entry)
     return read_dataset(folder)
 
 

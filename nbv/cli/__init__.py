@@ -8,9 +8,15 @@ parses its config with tyro (`nbv.cli.parse`) and calls the library.
 from __future__ import annotations
 
 import importlib
+import os
 import sys
+from collections.abc import Sequence
 from typing import NamedTuple
 
+from common.errors import describe
+from common.io import output_target
+from common.locks import WAIT, OutputBusy, claim, lock_scope
+from common.outpath import check_out_path
 from nbv.fanout.task import WorkerDied
 
 
@@ -46,6 +52,42 @@ ERRORS = (ValueError, FileExistsError, FileNotFoundError, PermissionError, Worke
 """Exceptions reported in one line, exit status 2: the user's input at fault, or a unit of work whose
 worker died twice (it is named)."""
 
+WAIT_FLAG = "--wait-for-lock"
+"""Any command: wait for an output another run is writing instead of failing at once (`common.locks`)."""
+
+
+def flag_values(args: Sequence[str], flag: str) -> list[str]:
+    """The values given to `flag` in `args` (`--out DIR` or `--out=DIR`)."""
+    values = [arg.partition("=")[2] for arg in args if arg.startswith(f"{flag}=")]
+    return values + [args[i + 1] for i, arg in enumerate(args[:-1]) if arg == flag]
+
+
+def check_early(args: Sequence[str]) -> None:
+    """Before the command is even imported: every `--out` is checked and locked (`hold_output`), every
+    `--ray HOST:PORT` must answer."""
+    for out in flag_values(args, "--out"):
+        check_out_path(out)
+        hold_output(out)
+    for address in flag_values(args, "--ray"):
+        if address.strip() != "auto":
+            from nbv.fanout.ray_pool import check_reachable
+
+            check_reachable(address)
+
+
+def hold_output(out: str) -> None:
+    """Hold the lock of `--out` for the whole command (`common.locks`): a second run on it fails at once,
+    naming this one. Where no lock can be made, the command's own checks name the fault."""
+    target = output_target(out)
+    if not os.path.isdir(os.path.dirname(os.path.abspath(target))):
+        return  # made (and locked) by the command, once its checks passed
+    try:
+        claim(target)
+    except OutputBusy:
+        raise
+    except OSError:
+        pass
+
 
 def usage() -> str:
     """The top-level help: every command with its one-line description."""
@@ -53,7 +95,8 @@ def usage() -> str:
     lines = ["usage: nbv COMMAND [OPTIONS]", "",
              "Appearance-based next-best-view planning toolkit (Bag of Views).", "", "commands:"]
     lines += [f"  {name:<{width}}  {command.help}" for name, command in COMMANDS.items()]
-    lines += ["", "`nbv COMMAND --help` lists a command's options."]
+    lines += ["", "`nbv COMMAND --help` lists a command's options.",
+              f"{WAIT_FLAG} (any command): wait for an output another run is writing, instead of failing."]
     return "\n".join(lines)
 
 
@@ -67,12 +110,19 @@ def main(argv: list[str] | None = None) -> int:
     if name not in COMMANDS:
         print(f"nbv: error: unknown command {name!r} (choose from {', '.join(COMMANDS)})", file=sys.stderr)
         return 2
-    module = importlib.import_module(f"nbv.cli.{COMMANDS[name].module}")
+    WAIT[0] = WAIT_FLAG in rest
+    rest = [arg for arg in rest if arg != WAIT_FLAG]
     try:
-        return int(module.main(rest, prog=f"nbv {name}") or 0)
+        with lock_scope():
+            check_early(rest)
+            module = importlib.import_module(f"nbv.cli.{COMMANDS[name].module}")
+            return int(module.main(rest, prog=f"nbv {name}") or 0)
     except ERRORS as err:
-        print(f"nbv {name}: error: {err}", file=sys.stderr)
+        print(f"nbv {name}: error: {describe(err) if isinstance(err, OSError) else err}", file=sys.stderr)
         return 2
+    except OSError as err:  # a full disk, an I/O error: what failed and where, in one line
+        print(f"nbv {name}: error: {describe(err)}", file=sys.stderr)
+        return 1
     except SystemExit as done:  # tyro's --help (0) and its messages about bad options (2)
         return 0 if done.code is None else done.code if isinstance(done.code, int) else 2
 

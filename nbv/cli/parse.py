@@ -24,6 +24,7 @@ import tyro
 from tyro._errors import InstantiationFailure, ParseErrorEvent, on_parse_error  # tyro is pinned exactly
 
 from common.provenance import recorded_config
+from nbv.cli import WAIT_FLAG
 
 T = TypeVar("T")
 
@@ -70,6 +71,7 @@ def parse(cls: type[T], args: Sequence[str], prog: str, default: T | None = None
     record, args = split_config(args)
     if record is not None:
         default = recorded_config(cls, record, prog)
-    text = f"{(description or inspect.getdoc(cls) or '').strip()}\n\n{CONFIG_HELP}"
+    text = (f"{(description or inspect.getdoc(cls) or '').strip()}\n\n{CONFIG_HELP}\n\n{WAIT_FLAG}: wait for "
+            "an output another run is writing, instead of failing at once.")
     with on_parse_error(_refused_value):
         return tyro.cli(cls, args=args, prog=prog, default=default, description=text, config=MARKERS)

@@ -17,13 +17,18 @@ same path. Ray is imported here only.
 from __future__ import annotations
 
 import atexit
+import socket
 from collections.abc import Callable, Sequence
 from types import ModuleType
 from typing import Any
 
+from common.errors import describe
 from nbv.fanout.task import Task, WorkerDied, discard_partial
 from nbv.fanout.worker import caller_context, run_in_worker, warm_worker
 
+CONNECT_TIMEOUT_S = 5.0
+"""Seconds a cluster address (`--ray HOST:PORT`) has to accept a connection before the run fails, naming it
+(Ray itself retries for minutes)."""
 RETRIES = 1
 """Times a unit is re-run after its worker died."""
 _OURS: list[tuple[str, int]] = []
@@ -34,6 +39,8 @@ def connect(address: str, cpus: int) -> ModuleType:
     """Ray, connected: 'auto' starts a local instance with `cpus` CPUs, anything else joins that cluster.
     A connection this module made for other settings is replaced; one made by someone else is used as
     it is. A new connection starts warming one worker per CPU. Returns the `ray` module."""
+    if address != "auto":
+        check_reachable(address)
     import ray
 
     wanted = (address, cpus if address == "auto" else 0)
@@ -49,6 +56,21 @@ def connect(address: str, cpus: int) -> ModuleType:
         for _ in range(int(ray.cluster_resources().get("CPU", 1))):
             warm.remote(1)
     return ray
+
+
+def check_reachable(address: str, timeout_s: float = CONNECT_TIMEOUT_S) -> None:
+    """Refuse (ValueError naming it) a cluster `address` (HOST:PORT, ray://HOST:PORT) where nothing accepts
+    a connection within `timeout_s`; an address of another form is left to Ray to judge."""
+    host, colon, port = address.strip().removeprefix("ray://").rpartition(":")
+    if not colon or not port.isdigit() or not host:
+        return
+    try:
+        with socket.create_connection((host.strip("[]"), int(port)), timeout=timeout_s):
+            pass
+    except OSError as err:
+        why = describe(err) if err.errno is not None else "no answer"
+        raise ValueError(f"ray {address}: nothing answers at {host}:{port} within {timeout_s:g} s ({why}); "
+                         "start the cluster there (`ray start --head`) or use --ray auto") from None
 
 
 def disconnect() -> None:

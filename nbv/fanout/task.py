@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from common.io import recover_stale
+from common.locks import lock_scope
 
 
 class WorkerDied(RuntimeError):
@@ -46,7 +47,8 @@ def run_task(task: Task) -> None:
     if task.done():
         return
     try:
-        task.fn(**task.kwargs)
+        with lock_scope():  # a worker outlives its units: their output locks end with them
+            task.fn(**task.kwargs)
     except Exception as err:
         err.add_note(f"in task {task.name!r}")
         raise

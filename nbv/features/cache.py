@@ -20,8 +20,8 @@ import cv2
 import kornia
 import torch
 
-from common.io import atomic_path
 from common.io import cache_dir as cache_root
+from common.io import write_cache
 from nbv.features.sift import DESCRIPTOR_DIM, FeatureConfig, Features, extract_features
 from render.dataset import ViewDataset
 from render.dataset_read import image_bytes
@@ -90,8 +90,7 @@ def dataset_features(dataset: ViewDataset, config: FeatureConfig, cache_dir: str
 
 
 def save_features(path: Path, feats: list[Features]) -> None:
-    """Write features as one flat tensor per field plus per-view counts (atomic)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
+    """Write features as one flat tensor per field plus per-view counts (atomic; a warning if it fails)."""
     doc = {
         "version": torch.tensor(CACHE_VERSION),
         "counts": torch.tensor([len(f) for f in feats], dtype=torch.long),
@@ -99,8 +98,7 @@ def save_features(path: Path, feats: list[Features]) -> None:
         "descriptors": torch.cat([f.descriptors.cpu() for f in feats]).float(),
         "responses": torch.cat([f.responses.cpu() for f in feats]).float(),
     }
-    with atomic_path(path) as tmp:
-        torch.save(doc, tmp)
+    write_cache(path, lambda tmp: torch.save(doc, tmp))  # if it fails: a warning, extracted again next time
 
 
 def load_features(path: Path, views: int) -> list[Features]:

@@ -28,6 +28,7 @@ from render.dataset_read import (
     DEPTH_SCALE,
     FORMAT_VERSION,
     DatasetError,
+    check_shared_images,
     contained_file,
     object_field,
     read_camera,
@@ -207,6 +208,7 @@ def read_dataset(path: str | Path) -> ViewDataset:
     if not raw_frames:
         raise DatasetError(f"{doc_path}: field frames is empty (a dataset needs at least one view)")
     frames = tuple(_read_frame(root, i, f, center, doc_path) for i, f in enumerate(raw_frames))
+    check_shared_images(((str(f.rgb_path), str(f.depth_path), f.c2w) for f in frames), doc_path)
     return ViewDataset(root, camera, frames, dict(nbv))
 
 

@@ -7,6 +7,7 @@ dataset whose every frame, pose and centre reads back valid; never another excep
 from __future__ import annotations
 
 import json
+import math
 import shutil
 import struct
 import zlib
@@ -17,7 +18,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from common.io import current_umask
+from common.io import current_umask, write_json
 from render.camera import UAVCamera
 from render.dataset import DatasetError, DatasetWriter, read_dataset
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
@@ -117,7 +118,7 @@ PROBE_CASES = {
     "S8_string_in_matrix": (_set("frames.0.transform_matrix.0.0", "1"), "must be a number"),
     "S8_string_viewpoint": (_set("frames.0.nbv.viewpoint.0", "2"), "must be a number"),
     "S8_string_near": (_set("nbv.near_m", "0.05"), "nbv.near_m must be a number"),
-    "S9_center_nan": (_set("nbv.center", [float("nan"), 0, 0]), r"nbv.center\[0\] is NaN"),
+    "S9_center_nan": (_set("nbv.center", [float("nan"), 0, 0]), "bare NaN token, which is not JSON"),
     "S9_center_null": (_set("nbv.center", None), "nbv.center must be a list"),
     "S11_frame_nbv_string": (_set("frames.0.nbv", ""), r"frames\[0\]\.nbv must be an object"),
     "S5_absolute_path": (_set("frames.1.file_path", "/etc/passwd"), "must be a relative path inside"),
@@ -183,6 +184,120 @@ def test_s10_images_that_are_not_what_they_claim_are_refused(base, tmp_path, kin
         target.write_bytes(bytes(data))
     with pytest.raises(DatasetError, match=f"{target.parent.name}/0001.png"):
         read_dataset(root).rgb(1)
+
+
+def _text_edit(root: Path, old: str, new: str) -> None:
+    path = root / "transforms.json"
+    text = path.read_text()
+    assert old in text
+    path.write_text(text.replace(old, new, 1))
+
+
+@pytest.mark.parametrize("old, new, key", [
+    ('"w": 32', '"w": 16, "w": 32', "'w'"),
+    ('"frames": [', '"frames": [], "frames": [', "'frames'"),
+    ('"fl_x": ', '"fl_x": 1000.0, "fl_x": ', "'fl_x'")])
+def test_duplicate_json_key_refused(base, tmp_path, old, new, key):
+    root = _copy(base, tmp_path / "ds")
+    _text_edit(root, old, new)
+    with pytest.raises(DatasetError, match=f"transforms.json: key {key} appears twice in one object"):
+        read_dataset(root)
+
+
+@pytest.mark.parametrize("token", ["NaN", "Infinity", "-Infinity"])
+def test_bare_nan_token_refused_anywhere(base, tmp_path, token):
+    root = _copy(base, tmp_path / "ds")
+    _text_edit(root, '"nbv": {', f'"aabb_scale": {token}, "nbv": {{"extra": [{token}], ')
+    with pytest.raises(DatasetError, match=f"transforms.json: bare {token} token, which is not JSON"):
+        read_dataset(root)
+
+
+def test_json_writers_never_write_nan(tmp_path):
+    with pytest.raises(ValueError, match="out.json: cannot write a NaN or infinite number as JSON"):
+        write_json(tmp_path / "out.json", {"extra": -math.inf})
+    assert not (tmp_path / "out.json").exists()
+
+
+def _png_chunks_of(data: bytes) -> list[tuple[bytes, bytes]]:
+    chunks, pos = [], 8
+    while pos < len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        chunks.append((kind, data[pos + 8:pos + 8 + length]))
+        pos += 12 + length
+    return chunks
+
+
+def _png_of(chunks: list[tuple[bytes, bytes]]) -> bytes:
+    return b"\x89PNG\r\n\x1a\n" + b"".join(struct.pack(">I", len(body)) + kind + body
+                                          + struct.pack(">I", zlib.crc32(kind + body))
+                                          for kind, body in chunks)
+
+
+@pytest.mark.parametrize("folder, row_bytes", [("images", SIZE[0] * 3 + 1), ("depth", SIZE[0] * 2 + 1)])
+def test_png_with_short_image_data_refused(base, tmp_path, folder, row_bytes):
+    root = _copy(base, tmp_path / "ds")
+    path = root / folder / "0001.png"
+    chunks = _png_chunks_of(path.read_bytes())
+    raw = zlib.decompress(b"".join(body for kind, body in chunks if kind == b"IDAT"))
+    assert len(raw) == SIZE[1] * row_bytes  # the hand-worked size: a filter byte per row
+    half = zlib.compress(raw[:row_bytes * SIZE[1] // 2])  # a valid stream holding the first 12 rows
+    path.write_bytes(_png_of([c for c in chunks if c[0] not in (b"IDAT", b"IEND")]
+                             + [(b"IDAT", half), (b"IEND", b"")]))
+    ds = read_dataset(root)
+    with pytest.raises(DatasetError, match=f"{folder}/0001.png: truncated PNG image data: "
+                                           f"{row_bytes * 12} of the {row_bytes * 24} bytes"):
+        ds.rgb(1) if folder == "images" else ds.depth(1)
+
+
+def test_interlaced_png_reads_back(base, tmp_path):
+    """An Adam7 PNG written by hand (seven passes, filter 0 on every row) is read whole."""
+    root = _copy(base, tmp_path / "ds")
+    image = read_dataset(root).rgb(2)
+    adam7 = ((0, 0, 8, 8), (4, 0, 8, 8), (0, 4, 4, 8), (2, 0, 4, 4), (0, 2, 2, 4), (1, 0, 2, 2), (0, 1, 1, 2))
+    passes = [image[y0::dy, x0::dx] for x0, y0, dx, dy in adam7]
+    raw = b"".join(b"\0" + row.tobytes() for rows in passes if rows.shape[1] for row in rows)
+    header = struct.pack(">IIBBBBB", SIZE[0], SIZE[1], 8, 2, 0, 0, 1)
+    (root / "images" / "0002.png").write_bytes(_png_of([(b"IHDR", header), (b"IDAT", zlib.compress(raw)),
+                                                        (b"IEND", b"")]))
+    assert np.array_equal(read_dataset(root).rgb(2), image)
+
+
+def test_frames_sharing_an_image_with_different_poses_refused(base, tmp_path):
+    root = _copy(base, tmp_path / "ds")
+    _edit(root, lambda doc: doc["frames"].append(dict(doc["frames"][0])))  # an identical repeat passes
+    assert len(read_dataset(root)) == 4
+    _edit(root, lambda doc: doc["frames"][1].update(file_path="images/0000.png",
+                                                    depth_file_path="depth/0000.png"))
+    with pytest.raises(DatasetError, match=r"frames\[0\] and frames\[1\] name the same file .*0000.png"
+                                           r".*with different poses"):
+        read_dataset(root)
+
+
+def test_animated_png_refused(base, tmp_path):
+    root = _copy(base, tmp_path / "ds")
+    path = root / "images" / "0000.png"
+    still = Image.open(path).convert("RGB")
+    still.save(path, save_all=True, append_images=[Image.new("RGB", still.size)], default_image=True)
+    assert b"acTL" in path.read_bytes()
+    with pytest.raises(DatasetError, match="0000.png: animated PNG .APNG, chunk acTL. is not supported"):
+        read_dataset(root).rgb(0)
+
+
+def test_lone_surrogate_in_file_path_refused(base, tmp_path):
+    root = _copy(base, tmp_path / "ds")
+    _text_edit(root, '"images/0001.png"', '"images/0001\\ud800.png"')
+    with pytest.raises(DatasetError, match=r"frames\[1\]\.file_path contains a lone surrogate"):
+        read_dataset(root)
+
+
+@pytest.mark.parametrize("char", ["\n", "\r", "\t", "\x1b", "\x85"])
+def test_control_character_in_image_name_refused(base, tmp_path, char):
+    root = _copy(base, tmp_path / "ds")
+    name = f"images/00{char}02.png"
+    (root / "images" / "0002.png").rename(root / name)
+    _edit(root, _set("frames.2.file_path", name))
+    with pytest.raises(DatasetError, match=r"frames\[2\]\.file_path contains a control character"):
+        read_dataset(root)
 
 
 def test_dataset_folders_follow_the_umask(base):

@@ -228,13 +228,8 @@ def write_text(path: str | Path, text: str) -> Path:
 
 
 def write_json(path: str | Path, doc: Any) -> Path:
-    """Write `doc` as indented, strict JSON atomically (a NaN or infinity, which strict readers refuse, is
-    a ValueError naming `path`); returns `path`."""
-    try:
-        text = json.dumps(doc, indent=2, allow_nan=False)
-    except ValueError as err:
-        raise ValueError(f"{path}: cannot write a NaN or infinite number as JSON ({err})") from err
-    return write_text(path, text)
+    """Write `doc` as indented JSON atomically; returns `path`."""
+    return write_text(path, json.dumps(doc, indent=2))
 
 
 def cache_dir() -> Path:

@@ -10,6 +10,7 @@ beside the target, renamed into place only when complete.
 
 from __future__ import annotations
 
+import json
 from collections.abc import Iterator
 from contextlib import ExitStack
 from dataclasses import dataclass, field
@@ -20,7 +21,7 @@ import cv2
 import numpy as np
 from PIL import Image
 
-from common.io import atomic_folder, check_output_folder, write_json
+from common.io import atomic_folder, check_output_folder, write_json, write_text
 from common.io import current_umask as current_umask  # re-exported: dataset folders use the umask
 from common.io import replace_folder as replace_folder  # re-exported for render.colmap
 from render.camera import UAVCamera
@@ -174,7 +175,18 @@ class DatasetWriter:
             if not self._frames:
                 raise ValueError(f"dataset {self.out}: no frames were added "
                                  "(a dataset needs at least one view)")
-            write_json(self._tmp / "transforms.json", transforms_json(self.camera, self._frames, self.meta))
+            write_strict_json(self._tmp / "transforms.json",
+                              transforms_json(self.camera, self._frames, self.meta))
+
+
+def write_strict_json(path: Path, doc: dict[str, Any]) -> None:
+    """Write `doc` as indented JSON that strict readers (JavaScript, serde, Go) accept: a NaN or infinity
+    is a ValueError naming `path`, never a bare `NaN` token."""
+    try:
+        text = json.dumps(doc, indent=2, allow_nan=False)
+    except ValueError as err:
+        raise ValueError(f"{path}: cannot write a NaN or infinite number as JSON ({err})") from err
+    write_text(path, text)
 
 
 def transforms_json(camera: UAVCamera, frames: list[dict[str, Any]], meta: dict[str, Any]) -> dict:

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from common.io import current_umask, write_json
+from common.io import current_umask
 from render.camera import UAVCamera
 from render.dataset import DatasetError, DatasetWriter, read_dataset
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
@@ -212,10 +212,16 @@ def test_bare_nan_token_refused_anywhere(base, tmp_path, token):
         read_dataset(root)
 
 
-def test_json_writers_never_write_nan(tmp_path):
-    with pytest.raises(ValueError, match="out.json: cannot write a NaN or infinite number as JSON"):
-        write_json(tmp_path / "out.json", {"extra": -math.inf})
-    assert not (tmp_path / "out.json").exists()
+def test_dataset_writer_never_writes_nan(tmp_path):
+    """A NaN or infinity reaching transforms.json (here a frame's own field) is refused, not written as a
+    bare token: the reader refuses those, and so do strict parsers elsewhere."""
+    camera = UAVCamera(*SIZE)
+    view = Viewpoint(2.0, 0.0, 0.3)
+    with pytest.raises(ValueError, match="transforms.json: cannot write a NaN or infinite number as JSON"):
+        with DatasetWriter(tmp_path / "ds", camera, {"center": CENTER}) as writer:
+            writer.add(np.zeros((SIZE[1], SIZE[0], 3), np.uint8), np.ones(SIZE[::-1], np.float32),
+                       viewpoint_to_c2w(view, np.array(CENTER)), view, {"extra": -math.inf})
+    assert not (tmp_path / "ds").exists()
 
 
 def _png_chunks_of(data: bytes) -> list[tuple[bytes, bytes]]:

@@ -66,7 +66,7 @@ def _hash_into(digest: Any, node: Any, where: str) -> None:
     if isinstance(node, torch.Tensor):
         data = node.detach().cpu().contiguous()
         digest.update(f"{where}:{data.dtype}:{tuple(data.shape)}\0".encode())
-        digest.update(data.reshape(-1).view(torch.uint8).numpy().tobytes())
+        digest.update(data.reshape(-1).view(torch.uint8).numpy())  # a buffer: hashed without a copy
     elif isinstance(node, dict):
         for key in sorted(node, key=str):
             if not (where == "" and key == CHECKSUM_KEY):

@@ -339,10 +339,11 @@ def _mutate_json(doc: dict, rng: np.random.Generator, outside: Path) -> None:
 
 
 def _mutate_text(root: Path, rng: np.random.Generator) -> None:
-    """Damage transforms.json as text: deep nesting, truncation, a flipped byte, another encoding."""
+    """Damage transforms.json as text: deep nesting, truncation, a flipped byte, another encoding, a key
+    twice, a bare NaN."""
     path = root / "transforms.json"
     data = bytearray(path.read_bytes())
-    action, pos = int(rng.integers(4)), int(rng.integers(len(data)))
+    action, pos = int(rng.integers(6)), int(rng.integers(len(data)))
     if action == 0:
         key = data.index(b'"frames": [') if rng.integers(2) else data.index(b'"nbv": {')
         nested = _deep(int(rng.choice([900, 5000, 100_000]))).encode()
@@ -351,8 +352,12 @@ def _mutate_text(root: Path, rng: np.random.Generator) -> None:
         del data[pos:]
     elif action == 2:
         data[pos] ^= 1 << int(rng.integers(8))
-    else:
+    elif action == 3:
         data = bytearray(data.decode().encode(["utf-16", "utf-8-sig", "utf-32"][int(rng.integers(3))]))
+    else:
+        key = [b'"w": ', b'"fl_x": ', b'"frames": ', b'"center": '][int(rng.integers(4))]
+        extra = b"NaN, " if action == 4 else [b"-Infinity, ", b"Infinity, "][int(rng.integers(2))]
+        data = data.replace(key, key + extra + key, 1)
     path.write_bytes(bytes(data))
 
 
@@ -361,9 +366,15 @@ def _mutate_png(root: Path, rng: np.random.Generator) -> None:
     folder = ["images", "depth"][int(rng.integers(2))]
     path = root / folder / f"{int(rng.integers(3)):04d}.png"
     data = bytearray(path.read_bytes())
-    action = int(rng.integers(7))
+    action = int(rng.integers(9))
     if action == 0:
         path.write_bytes(bytes(data[:int(rng.integers(len(data)))]))
+    elif action in (7, 8):  # image data short of its rows (valid stream and CRCs), or an APNG chunk
+        chunks = _png_chunks_of(bytes(data))
+        raw = zlib.decompress(b"".join(body for kind, body in chunks if kind == b"IDAT"))
+        tail = ([(b"IDAT", zlib.compress(raw[:int(rng.integers(len(raw)))]))] if action == 7
+                else [(b"acTL", struct.pack(">II", 2, 0))] + [c for c in chunks if c[0] == b"IDAT"])
+        path.write_bytes(_png_of([chunks[0], *tail, (b"IEND", b"")]))
     elif action == 1:
         for pos in rng.integers(0, len(data), int(rng.integers(1, 8))):
             data[pos] ^= int(rng.integers(1, 256))

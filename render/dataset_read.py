@@ -78,14 +78,37 @@ def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     return doc
 
 
-def _no_constant(token: str) -> float:
-    raise StrictJSONError(f"bare {token} token, which is not JSON (strict readers refuse it); "
-                          f"write a finite number")
+class _BareToken:
+    """Stands where the text held a bare NaN, Infinity or -Infinity, so its field can be named."""
+
+    def __init__(self, token: str) -> None:
+        self.token = token
+
+
+def _bare_token_field(doc: Any) -> tuple[str, str] | None:
+    """(field path, token) of the first `_BareToken` in document order, None when there is none."""
+    stack: list[tuple[str, Any]] = [("", doc)]
+    while stack:
+        where, node = stack.pop()
+        if isinstance(node, _BareToken):
+            return where, node.token
+        if isinstance(node, dict):
+            stack.extend((f"{where}.{k}" if where else str(k), v) for k, v in reversed(node.items()))
+        elif isinstance(node, list):
+            stack.extend((f"{where}[{i}]", v) for i, v in reversed(list(enumerate(node))))
+    return None
 
 
 def strict_json_loads(text: str) -> Any:
-    """`json.loads` refusing duplicate keys and bare NaN / Infinity / -Infinity (StrictJSONError)."""
-    return json.loads(text, object_pairs_hook=_unique_keys, parse_constant=_no_constant)
+    """`json.loads` refusing duplicate keys and bare NaN / Infinity / -Infinity (StrictJSONError naming
+    the field)."""
+    doc = json.loads(text, object_pairs_hook=_unique_keys, parse_constant=_BareToken)
+    found = _bare_token_field(doc)
+    if found is not None:
+        field, token = found
+        raise StrictJSONError(f"field {field or '(top level)'} is a bare {token} token, which is not JSON "
+                              f"(strict readers refuse it); write a finite number")
+    return doc
 
 
 def read_document(doc_path: Path) -> dict[str, Any]:

@@ -118,7 +118,7 @@ PROBE_CASES = {
     "S8_string_in_matrix": (_set("frames.0.transform_matrix.0.0", "1"), "must be a number"),
     "S8_string_viewpoint": (_set("frames.0.nbv.viewpoint.0", "2"), "must be a number"),
     "S8_string_near": (_set("nbv.near_m", "0.05"), "nbv.near_m must be a number"),
-    "S9_center_nan": (_set("nbv.center", [float("nan"), 0, 0]), "bare NaN token, which is not JSON"),
+    "S9_center_nan": (_set("nbv.center", [float("nan"), 0, 0]), r"field nbv.center\[0\] is a bare NaN token"),
     "S9_center_null": (_set("nbv.center", None), "nbv.center must be a list"),
     "S11_frame_nbv_string": (_set("frames.0.nbv", ""), r"frames\[0\]\.nbv must be an object"),
     "S5_absolute_path": (_set("frames.1.file_path", "/etc/passwd"), "must be a relative path inside"),
@@ -208,7 +208,8 @@ def test_duplicate_json_key_refused(base, tmp_path, old, new, key):
 def test_bare_nan_token_refused_anywhere(base, tmp_path, token):
     root = _copy(base, tmp_path / "ds")
     _text_edit(root, '"nbv": {', f'"aabb_scale": {token}, "nbv": {{"extra": [{token}], ')
-    with pytest.raises(DatasetError, match=f"transforms.json: bare {token} token, which is not JSON"):
+    message = rf"transforms.json: field frames\[0\]\.aabb_scale is a bare {token} token, which is not JSON"
+    with pytest.raises(DatasetError, match=message):
         read_dataset(root)
 
 

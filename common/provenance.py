@@ -51,7 +51,16 @@ def config_from_record(cls: type[T], record: dict) -> T:
     unknown = sorted(set(record) - set(fields))
     if unknown:
         raise ValueError(f"{cls.__name__} has no field(s) {', '.join(unknown)}")
+    for name, value in record.items():
+        _check_choice(cls, name, hints[name], value)
     return cls(**{name: _value(hints[name], value) for name, value in record.items()})
+
+
+def _check_choice(cls: type, name: str, tp: Any, value: Any) -> None:
+    """Refuse a value outside a `Literal` field's choices (a record is not checked by tyro's parser)."""
+    if typing.get_origin(tp) is typing.Literal and value not in typing.get_args(tp):
+        choices = ", ".join(repr(c) for c in typing.get_args(tp))
+        raise ValueError(f"{cls.__name__} field {name} is {value!r}, not one of {choices}")
 
 
 def _value(tp: Any, value: Any) -> Any:

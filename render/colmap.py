@@ -15,6 +15,7 @@ from __future__ import annotations
 import os
 import shutil
 import struct
+import unicodedata
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -59,6 +60,8 @@ class ExportConfig:
     def __post_init__(self) -> None:
         if self.points_per_view < 1:
             raise ValueError(f"points_per_view must be >= 1, got {self.points_per_view}")
+        if self.seed < 0:
+            raise ValueError(f"seed must be >= 0, got {self.seed}")
 
 
 @dataclass(frozen=True)
@@ -145,7 +148,7 @@ def build_model(dataset: ViewDataset, points_per_view: int, seed: int) -> Colmap
     """The COLMAP model of a dataset; `points_per_view` 0 leaves the points empty."""
     camera, rng = dataset.camera, np.random.default_rng(seed)
     k = camera.K
-    names = tuple(frame.rgb_path.name for frame in dataset.frames)
+    names = tuple(colmap_name(frame.rgb_path) for frame in dataset.frames)
     if len(set(names)) < len(names):
         raise ValueError(f"{dataset.root}: image file names repeat; COLMAP names images by file name")
     poses = [world_to_camera(frame.c2w) for frame in dataset.frames]
@@ -162,6 +165,18 @@ def build_model(dataset: ViewDataset, points_per_view: int, seed: int) -> Colmap
         names,
         np.array([q for q, _ in poses]).reshape(-1, 4), np.array([t for _, t in poses]).reshape(-1, 3),
         np.concatenate(xyz), np.concatenate(rgb), np.concatenate(image_of), np.concatenate(pixels))
+
+
+def colmap_name(path: Path) -> str:
+    """The file name of `path` as COLMAP's images.txt writes it, refused (ValueError naming the file) when
+    it holds whitespace or a control character: the text format splits fields at spaces, lines at
+    newlines."""
+    name = path.name
+    if any(c.isspace() or unicodedata.category(c) in ("Cc", "Cs") for c in name):
+        raise ValueError(f"{path}: COLMAP's images.txt cannot hold the image name {ascii(name)} (fields are "
+                         f"split at spaces, lines at newlines); rename it without spaces or control "
+                         f"characters")
+    return name
 
 
 def place_images(dataset: ViewDataset, folder: Path, mode: str) -> None:

@@ -11,6 +11,7 @@ beside the target, renamed into place only when complete.
 from __future__ import annotations
 
 import errno
+import json
 from collections.abc import Iterator
 from contextlib import ExitStack
 from dataclasses import dataclass, field
@@ -21,7 +22,7 @@ import cv2
 import numpy as np
 from PIL import Image
 
-from common.io import atomic_folder, check_output_folder, write_json
+from common.io import atomic_folder, check_output_folder, write_json, write_text
 from common.io import current_umask as current_umask  # re-exported: dataset folders use the umask
 from common.io import replace_folder as replace_folder  # re-exported for render.colmap
 from render.camera import UAVCamera
@@ -29,6 +30,7 @@ from render.dataset_read import (
     DEPTH_SCALE,
     FORMAT_VERSION,
     DatasetError,
+    check_shared_images,
     contained_file,
     object_field,
     read_camera,
@@ -176,7 +178,18 @@ class DatasetWriter:
             if not self._frames:
                 raise ValueError(f"dataset {self.out}: no frames were added "
                                  "(a dataset needs at least one view)")
-            write_json(self._tmp / "transforms.json", transforms_json(self.camera, self._frames, self.meta))
+            write_strict_json(self._tmp / "transforms.json",
+                              transforms_json(self.camera, self._frames, self.meta))
+
+
+def write_strict_json(path: Path, doc: dict[str, Any]) -> None:
+    """Write `doc` as indented JSON that strict readers (JavaScript, serde, Go) accept: a NaN or infinity
+    is a ValueError naming `path`, never a bare `NaN` token."""
+    try:
+        text = json.dumps(doc, indent=2, allow_nan=False)
+    except ValueError as err:
+        raise ValueError(f"{path}: cannot write a NaN or infinite number as JSON ({err})") from err
+    write_text(path, text)
 
 
 def transforms_json(camera: UAVCamera, frames: list[dict[str, Any]], meta: dict[str, Any]) -> dict:
@@ -210,6 +223,7 @@ def read_dataset(path: str | Path) -> ViewDataset:
     if not raw_frames:
         raise DatasetError(f"{doc_path}: field frames is empty (a dataset needs at least one view)")
     frames = tuple(_read_frame(root, i, f, center, doc_path) for i, f in enumerate(raw_frames))
+    check_shared_images(((str(f.rgb_path), str(f.depth_path), f.c2w) for f in frames), doc_path)
     return ViewDataset(root, camera, frames, dict(nbv))
 
 

@@ -12,8 +12,11 @@ from __future__ import annotations
 import io
 import json
 import math
+import os
 import struct
+import unicodedata
 import zlib
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
@@ -47,20 +50,77 @@ FOCAL_RTOL = 1e-4
 VIEWPOINT_RTOL = 1e-4
 """Tolerance between a recorded viewpoint's position and its pose, relative to max(1, R)."""
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+_PNG_CHANNELS = {0: 1, 2: 3, 3: 1, 4: 2, 6: 4}
+"""Samples per pixel of each PNG colour type."""
+_ADAM7 = ((0, 0, 8, 8), (4, 0, 8, 8), (0, 4, 4, 8), (2, 0, 4, 4), (0, 2, 2, 4), (1, 0, 2, 2), (0, 1, 1, 2))
+"""The seven passes of an interlaced PNG: (x0, y0, dx, dy)."""
+_APNG_CHUNKS = (b"acTL", b"fcTL", b"fdAT")
+"""Chunks only an animated PNG holds."""
 
 
 class DatasetError(ValueError):
     """A dataset on disk is missing, corrupt or inconsistent; the message names the file and field."""
 
 
+class StrictJSONError(ValueError):
+    """A document that parses only by a lenient reader: a key twice in one object, or a bare NaN or
+    Infinity token (not JSON; strict readers refuse it)."""
+
+
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """An object's pairs as a dict, refusing a key that appears twice (readers disagree on which wins)."""
+    doc: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in doc:
+            raise StrictJSONError(f"key {key!r} appears twice in one object (readers disagree on which "
+                                  f"one wins); keep one")
+        doc[key] = value
+    return doc
+
+
+class _BareToken:
+    """Stands where the text held a bare NaN, Infinity or -Infinity, so its field can be named."""
+
+    def __init__(self, token: str) -> None:
+        self.token = token
+
+
+def _bare_token_field(doc: Any) -> tuple[str, str] | None:
+    """(field path, token) of the first `_BareToken` in document order, None when there is none."""
+    stack: list[tuple[str, Any]] = [("", doc)]
+    while stack:
+        where, node = stack.pop()
+        if isinstance(node, _BareToken):
+            return where, node.token
+        if isinstance(node, dict):
+            stack.extend((f"{where}.{k}" if where else str(k), v) for k, v in reversed(node.items()))
+        elif isinstance(node, list):
+            stack.extend((f"{where}[{i}]", v) for i, v in reversed(list(enumerate(node))))
+    return None
+
+
+def strict_json_loads(text: str) -> Any:
+    """`json.loads` refusing duplicate keys and bare NaN / Infinity / -Infinity (StrictJSONError naming
+    the field)."""
+    doc = json.loads(text, object_pairs_hook=_unique_keys, parse_constant=_BareToken)
+    found = _bare_token_field(doc)
+    if found is not None:
+        field, token = found
+        raise StrictJSONError(f"field {field or '(top level)'} is a bare {token} token, which is not JSON "
+                              f"(strict readers refuse it); write a finite number")
+    return doc
+
+
 def read_document(doc_path: Path) -> dict[str, Any]:
-    """The parsed `transforms.json` object."""
+    """The parsed `transforms.json` object (strict JSON: no duplicate keys, no NaN or Infinity)."""
     if not doc_path.is_file():
         raise DatasetError(f"{doc_path}: not found (is {doc_path.parent} a view dataset?)")
     if doc_path.stat().st_size > MAX_JSON_BYTES:
         raise DatasetError(f"{doc_path}: larger than {MAX_JSON_BYTES} bytes")
     try:
-        doc = json.loads(doc_path.read_text(encoding="utf-8"))
+        doc = strict_json_loads(doc_path.read_text(encoding="utf-8"))
+    except StrictJSONError as err:
+        raise DatasetError(f"{doc_path}: {err}") from err
     except RecursionError as err:
         raise DatasetError(f"{doc_path}: corrupt JSON: nested too deeply") from err
     except (OSError, ValueError) as err:  # JSONDecodeError, UnicodeDecodeError and the int digit limit
@@ -181,11 +241,22 @@ def read_render_settings(nbv: dict, where: Path) -> RenderSettings | None:
         raise DatasetError(f"{where}: field nbv.render: {err}") from err
 
 
+def check_name(value: str, where: Path, name: str) -> str:
+    """`value` when it is a file name that every tool can write and read back: valid UTF-8 (no lone
+    surrogate) without control characters (a newline would split a COLMAP or CSV line)."""
+    bad = next((c for c in value if unicodedata.category(c) in ("Cc", "Cs")), None)
+    if bad is not None:
+        kind = "a lone surrogate" if unicodedata.category(bad) == "Cs" else "a control character"
+        raise DatasetError(f"{where}: field {name} contains {kind} ({ascii(bad)}) in {ascii(value)}; "
+                           f"rename the file with printable UTF-8 characters")
+    return value
+
+
 def contained_file(root: Path, value: str, where: Path, name: str) -> Path:
     """`root / value`, an existing regular file that stays inside `root` (symlinks resolved)."""
     if "\0" in value or not value or Path(value).is_absolute():
         raise DatasetError(f"{where}: field {name} must be a relative path inside the dataset, got {value!r}")
-    path = root / value
+    path = root / check_name(value, where, name)
     try:
         inside = path.resolve().is_relative_to(root.resolve())
         exists = path.is_file()
@@ -229,11 +300,55 @@ def read_viewpoint(meta: dict, c2w: np.ndarray, center: np.ndarray, where: Path,
     return view
 
 
-def _png_chunks(data: bytes, path: Path) -> tuple[int, int, int, int]:
-    """(width, height, bit depth, colour type) of a complete PNG whose every chunk CRC is right."""
+def check_shared_images(frames: Iterable[tuple[str, str, np.ndarray]], where: Path) -> None:
+    """Refuse two frames naming one image (or depth) file with different poses; `frames`: each frame's
+    (file_path, depth_file_path, camera-to-world), in order. Identical repeated frames pass."""
+    seen: dict[str, tuple[int, np.ndarray]] = {}
+    for i, (rgb, depth, c2w) in enumerate(frames):
+        for key, value in (("file_path", rgb), ("depth_file_path", depth)):
+            first, pose = seen.setdefault(os.path.normpath(value), (i, c2w))
+            if first != i and not np.allclose(pose, c2w, rtol=0.0, atol=1e-9):
+                raise DatasetError(f"{where}: frames[{first}] and frames[{i}] name the same file {value!r} "
+                                   f"({key}) with different poses; give each view its own image")
+
+
+def png_data_size(width: int, height: int, bits: int, colour: int, interlaced: bool) -> int:
+    """Bytes of a PNG's filtered image data (a filter byte per row of each pass), from its header.
+
+    Example:
+        >>> png_data_size(64, 48, 8, 2, False)
+        9264
+    """
+    channels = _PNG_CHANNELS.get(colour, 1)
+
+    def rows(w: int, h: int) -> int:
+        return 0 if w == 0 else h * (1 + (w * channels * bits + 7) // 8)
+    if not interlaced:
+        return rows(width, height)
+    return sum(rows(max(0, -(-(width - x0) // dx)), max(0, -(-(height - y0) // dy)))
+               for x0, y0, dx, dy in _ADAM7)
+
+
+def check_png_rows(idat: bytes, header: tuple[int, int, int, int, int], path: Path) -> None:
+    """Refuse PNG image data (`idat`, the IDAT chunks joined) that inflates to fewer bytes than its
+    header's rows need: decoders fill the missing rows with black and say nothing."""
+    width, height, bits, colour, interlace = header
+    expected = png_data_size(width, height, bits, colour, interlace == 1)
+    try:
+        size = len(zlib.decompressobj().decompress(idat, expected + 1))
+    except zlib.error as err:
+        raise DatasetError(f"{path}: corrupt PNG image data ({err})") from err
+    if size < expected:
+        raise DatasetError(f"{path}: truncated PNG image data: {size} of the {expected} bytes its "
+                           f"{width}x{height} header needs (rows missing); re-save the image")
+
+
+def _png_chunks(data: bytes, path: Path) -> tuple[tuple[int, int, int, int, int], bytes]:
+    """(width, height, bit depth, colour type, interlace method) and the joined IDAT data of a complete,
+    still PNG whose every chunk CRC is right."""
     if not data.startswith(_PNG_SIGNATURE):
         raise DatasetError(f"{path}: not a PNG file")
-    pos, header = len(_PNG_SIGNATURE), None
+    pos, header, idat = len(_PNG_SIGNATURE), None, []
     while True:
         if pos + 12 > len(data):
             raise DatasetError(f"{path}: truncated PNG (no IEND chunk)")
@@ -247,9 +362,14 @@ def _png_chunks(data: bytes, path: Path) -> tuple[int, int, int, int]:
         if header is None:
             if kind != b"IHDR" or length != 13:
                 raise DatasetError(f"{path}: corrupt PNG (first chunk is not IHDR)")
-            header = struct.unpack(">IIBB", body[:10])
+            header = struct.unpack(">IIBBBBB", body)
+        if kind in _APNG_CHUNKS:
+            raise DatasetError(f"{path}: animated PNG (APNG, chunk {kind.decode()}) is not supported; "
+                               f"save one still image")
+        if kind == b"IDAT":
+            idat.append(body)
         if kind == b"IEND":
-            return header
+            return header[:4] + header[6:], b"".join(idat)
         pos = end
 
 
@@ -277,7 +397,8 @@ def read_png(path: Path, width: int, height: int, depth: bool) -> np.ndarray:
     RGB: H x W x 3 uint8 (8-bit or palette PNG). Depth: H x W uint16 (16-bit gray PNG).
     """
     data = image_bytes(path, width, height)
-    w, h, bits, colour = _png_chunks(data, path)
+    header, idat = _png_chunks(data, path)
+    w, h, bits, colour, _ = header
     if (w, h) != (width, height):
         raise DatasetError(f"{path}: image is {w}x{h}, transforms.json says w={width}, h={height}")
     if depth and (bits, colour) != (16, 0):
@@ -285,6 +406,7 @@ def read_png(path: Path, width: int, height: int, depth: bool) -> np.ndarray:
                            f"got bit depth {bits}, colour type {colour}")
     if not depth and bits > 8:
         raise DatasetError(f"{path}: RGB image must have 8-bit channels, got bit depth {bits}")
+    check_png_rows(idat, header, path)
     try:
         if depth:
             image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED)

@@ -6,15 +6,19 @@ base colour and texture. A sub-mesh without a texture gets a procedural one
 projected by planar UVs. The result is normalised (docs/conventions.md) after
 turning `up_axis` to z, over the vertices faces use (unreferenced ones are
 dropped), and stands on a textured ground. Arrays are checked before use: NaN
-vertices, meshes without faces, out-of-range face indices, corrupt textures and
-a target of zero or overflowing size raise a ValueError naming the file and the
-fault. A Mitsuba XML file is loaded once on load, so its errors name it too.
+vertices, meshes without faces, out-of-range face indices, corrupt textures, a
+target of zero or overflowing size or of no area raise a ValueError naming the
+file and the fault; so do referenced files that are not regular files (a FIFO
+would block) and short ASCII PLY bodies (`scenes.mesh_files`). A referenced file
+that is missing is a warning. A Mitsuba XML file is loaded once on load, so its
+errors name it too.
 """
 
 from __future__ import annotations
 
 import hashlib
 import io
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +26,7 @@ import trimesh
 from PIL import Image
 
 from common.io import atomic_path, cache_dir
+from scenes.mesh_files import GuardedResolver, check_ply_counts, resolve_obj_indices, texture_failures
 from scenes.model import Material, Part, Scene, validate_arrays
 from scenes.normalise import make_ground, normalise_parts
 from scenes.surface import Finish, make_part, planar_uv
@@ -34,6 +39,9 @@ UNTEXTURED = Finish("stone_sandstone")
 """The procedural finish of sub-meshes that carry no texture."""
 UNTEXTURED_TILE_M = 0.35
 """Metres (normalised) per tile of the procedural texture."""
+MIN_TARGET_AREA = 1e-9
+"""Least total face area of a normalised target (1 m across), square metres: below it every face is
+degenerate (repeated or collinear vertices) and nothing would be seen."""
 
 
 def is_scene_file(spec: str) -> bool:
@@ -64,17 +72,55 @@ def load_file_scene(path: str | Path, up_axis: str = "z", ground: bool = True) -
         parts = list(normalise_parts(raw, up_axis))
     except ValueError as err:
         raise ValueError(f"{path}: {err}") from err
+    area = sum(_area(p) for p in parts if p.target)
+    if not area >= MIN_TARGET_AREA:
+        raise ValueError(f"{path}: the target mesh has no area ({area:.3g} m^2 once normalised): every face "
+                         f"repeats or lines up its vertices, so nothing would be seen")
     parts = [_with_procedural_texture(p) if p.uv is None else p for p in parts]
     if ground:
         parts.append(make_ground(Finish("grass"), 0, half_m=3.0, tile_m=0.5))
     return Scene(name=str(path), parts=tuple(parts))
 
 
-def _read_parts(path: Path) -> list[Part]:
+def _area(part: Part) -> float:
+    corners = part.vertices[part.faces]
+    with np.errstate(over="ignore", invalid="ignore"):
+        cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    return 0.5 * float(np.linalg.norm(cross, axis=1).sum())
+
+
+def _load_checked(path: Path) -> trimesh.Scene:
+    """trimesh's scene of `path`, its referenced files opened by a `GuardedResolver`, its OBJ indices
+    resolved and its PLY counts checked; ValueError naming the file for what trimesh would let pass."""
+    resolver, suffix, text = GuardedResolver(path), path.suffix.lower(), None
     try:
-        loaded = trimesh.load(str(path), force="scene", process=False)
+        if suffix == ".ply":
+            check_ply_counts(path)
+        if suffix == ".obj":
+            text = resolve_obj_indices(path.read_bytes().decode("utf-8", errors="replace"))
+    except (ValueError, OSError) as err:
+        raise ValueError(f"{path}: {err}") from err
+    try:
+        with texture_failures() as failures:
+            if text is not None:
+                loaded = trimesh.load(io.BytesIO(text.encode()), file_type="obj", resolver=resolver,
+                                      force="scene", process=False)
+            else:
+                loaded = trimesh.load(str(path), force="scene", process=False, resolver=resolver)
     except Exception as err:  # trimesh raises many types for malformed files
         raise ValueError(f"{path}: cannot read mesh ({type(err).__name__}: {err})") from err
+    if resolver.refused:
+        raise ValueError(f"{path}: {resolver.refused[0]}")
+    if failures:
+        raise ValueError(f"{path}: a texture cannot be used ({failures[0]}); fix or remove it")
+    for name in resolver.missing:
+        warnings.warn(f"{path}: referenced file {name!r} not found; its parts get the procedural texture",
+                      stacklevel=4)
+    return loaded
+
+
+def _read_parts(path: Path) -> list[Part]:
+    loaded = _load_checked(path)
     parts: list[Part] = []
     for node in loaded.graph.nodes_geometry:
         transform, geometry_name = loaded.graph[node]

@@ -22,6 +22,7 @@ import torch
 from tyro.conf import Positional, arg
 
 from common.io import check_output_folder, check_separate
+from common.memory import check_memory
 from common.provenance import config_record, run_record
 from common.threads import set_torch_threads
 from nbv.bov.bag import BagOfViews
@@ -30,6 +31,10 @@ from nbv.features.cache import dataset_features
 from nbv.features.sift import DESCRIPTOR_DIM, Features
 from render.dataset import ViewDataset, read_dataset, write_subset
 from render.viewpoint import c2w_to_viewpoint
+
+FEATURE_BYTES = 2 * 4 * (DESCRIPTOR_DIM + 3)
+"""Bytes one SIFT feature of a view takes while refining: float32 descriptor, keypoint and response, held
+twice (the per-view features and the cache file's concatenation)."""
 
 Progress = Callable[[int], None]
 """Called with a count of work just done (e.g. a tqdm bar's `update`)."""
@@ -140,9 +145,12 @@ def load_views(run: DatasetRun, rule: BoVRule, progress: Progress | None = None
     if run.device.startswith("cuda") and int(run.device.partition(":")[2] or 0) >= torch.cuda.device_count():
         raise ValueError(f"device {run.device!r}: torch sees {torch.cuda.device_count()} CUDA GPU(s) here")
     dataset = read_dataset(run.dataset)
+    config = rule.feature_config(run.device)
+    check_memory(f"refine of {len(dataset)} views of {run.dataset}", len(dataset),
+                 config.max_features * FEATURE_BYTES, "refine fewer views or lower --max-features")
     if run.threads > 0:  # 0 leaves the process's choice (or the thread policy) as it was
         set_torch_threads(run.threads)
-    feats = dataset_features(dataset, rule.feature_config(run.device), run.cache_dir, progress)
+    feats = dataset_features(dataset, config, run.cache_dir, progress)
     return dataset, feats, frame_azimuths(dataset)
 
 

@@ -33,10 +33,22 @@ MARKERS = (tyro.conf.OmitArgPrefixes, tyro.conf.CascadeSubcommandArgs)
 own options accepted after a subcommand (`nbv scan SCENE circle --views 8 --out DIR`)."""
 
 
+_NOT_AN_INT = "invalid literal for int() with base 10: "
+"""How Python's `int()` refuses a string, which names neither the option nor what it expects."""
+
+
 def _refused_value(event: ParseErrorEvent) -> None:
-    """Re-raise a config's own ValueError (it names the field) instead of letting tyro box it."""
-    if isinstance(event, InstantiationFailure):
+    """Re-raise a config's own ValueError (it names the field) instead of letting tyro box it; a value
+    tyro could not convert (e.g. `--seed 1e3`) is named by its option."""
+    if not isinstance(event, InstantiationFailure):
+        return
+    if event.argument is None:
         raise ValueError(event.message)
+    option = event.argument.display_name()
+    if _NOT_AN_INT in event.message:  # alone, or one line of an `int | None` option's message
+        value = event.message.partition(_NOT_AN_INT)[2].splitlines()[0]
+        raise ValueError(f"{option} must be a whole number in decimal digits (e.g. 64), got {value}")
+    raise ValueError(f"{option}: {event.message}")
 
 
 CONFIG_HELP = ("--config RECORD: start from the config recorded in RECORD (this command's plan.json, "

@@ -13,12 +13,18 @@ from typing import Annotated
 
 from tyro.conf import arg
 
+from common.memory import check_memory
 from nbv.bov.config import BoVConfig
 from nbv.planning.registry import entry, planner_help
 from nbv.recon.config import MetricsConfig, OccupancyConfig, ReconstructionConfig
 from render.camera import UAVCamera
+from render.scan import check_views
 from render.settings import RenderSettings
 from scenes.spec import SceneSpec
+
+VIEW_PIXEL_BYTES = 16
+"""Bytes per pixel of a planned view held until the plan ends (an estimate: its uint8 RGB and float32
+depth, 7 bytes, about doubled for the copies the planner and the fusion make)."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -68,4 +74,11 @@ class PlanConfig:
     def __post_init__(self) -> None:
         if self.views is not None and self.views < 1:
             raise ValueError(f"views must be >= 1 (or left out for the planner's default), got {self.views}")
+        if self.views is not None:
+            check_views("views", self.views)
+            camera = self.settings.camera
+            check_memory(f"views {self.views} at {camera.width}x{camera.height}", self.views,
+                         camera.width * camera.height * VIEW_PIXEL_BYTES, "plan fewer --views")
+        if self.seed < 0:
+            raise ValueError(f"seed must be >= 0, got {self.seed}")
         entry(self.planner)  # an unknown planner fails here, naming every one

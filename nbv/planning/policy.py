@@ -38,7 +38,7 @@ class PolicyPlanner(Planner):
     name = "policy"
 
     def __init__(self, checkpoint: str | Path, sample: bool = False, seed: int = 0) -> None:
-        self.sample, self.seed = sample, seed
+        self.sample, self.seed, self.checkpoint = sample, seed, checkpoint
         config, weights = load_policy(checkpoint)
         try:
             self.env_config = config_from_record(EnvConfig, config["env"])
@@ -74,7 +74,10 @@ class PolicyPlanner(Planner):
         on the world's settings and view source (the env draws the world's start view)."""
         self.check_env(world.env)
         env = NBVEnv(world.env, seed=world.seed, source=world.source)
-        return policy_views(self.actor, env, views, self.sample, self.seed)
+        try:
+            return policy_views(self.actor, env, views, self.sample, self.seed)
+        except ValueError as err:  # e.g. a NaN action from finite but diverged weights: name the file
+            raise ValueError(f"policy {self.checkpoint}: {err}") from err
 
 
 def policy_planner(settings: PlanSettings, seed: int, checkpoint: str | None) -> PolicyPlanner:

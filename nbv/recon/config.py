@@ -11,10 +11,21 @@ from typing import Annotated, Literal
 
 from tyro.conf import Suppress, arg
 
+from common.memory import check_memory
+
 MAX_BLOCK_RESOLUTION = 64
 """Most voxels per block side."""
 MAX_INITIAL_VOXELS = 2**28
 """Most voxels allocated up front (initial_blocks x block_resolution^3): about 5 GB with colour."""
+MIN_VOXEL_SIZE_M = 1e-4
+"""Smallest voxel edge, metres (0.1 mm: 10^4 voxels across the normalised 1 m target). Finer grids fuse
+garbage (neighbouring depth samples land many voxels apart, so no surface closes) and their hash map
+outgrows memory."""
+METRIC_POINT_BYTES = 256
+"""Peak bytes per sampled metric point: 236 measured for a 2 * 10^6-point comparison of two meshes (the
+samples, the k-d tree and the distances), rounded up."""
+GRID_VOXEL_BYTES = 4
+"""Bytes per occupancy voxel: its uint8 state, the carve's bool mask, and room for one copy."""
 
 
 @dataclass(frozen=True)
@@ -48,6 +59,9 @@ class ReconstructionConfig:
             value = getattr(self, name)
             if not math.isfinite(value) or value <= 0:
                 raise ValueError(f"reconstruction {name} must be positive and finite, got {value!r}")
+        if self.voxel_size_m < MIN_VOXEL_SIZE_M:
+            raise ValueError(f"reconstruction voxel_size_m must be at least {MIN_VOXEL_SIZE_M} m, got "
+                             f"{self.voxel_size_m!r}: finer voxels fuse no closed surface (default 0.004)")
         if self.truncation_m < self.voxel_size_m:
             raise ValueError(f"reconstruction truncation_m ({self.truncation_m}) must be at least "
                              f"one voxel ({self.voxel_size_m})")
@@ -83,6 +97,8 @@ class MetricsConfig:
     def __post_init__(self) -> None:
         if self.n_points < 1:
             raise ValueError(f"metrics n_points must be >= 1, got {self.n_points}")
+        check_memory(f"metrics n_points (--metric-points) {self.n_points}", self.n_points, METRIC_POINT_BYTES,
+                     "use fewer points (default 1000000)")
         if not math.isfinite(self.threshold_cm) or self.threshold_cm <= 0:
             raise ValueError(f"metrics threshold_cm must be positive, got {self.threshold_cm}")
 
@@ -129,5 +145,8 @@ class OccupancyConfig:
         for name in ("grid_resolution", "gain_ray_stride", "integrate_ray_stride"):
             if getattr(self, name) < 1:
                 raise ValueError(f"occupancy {name} must be >= 1, got {getattr(self, name)}")
+        check_memory(f"occupancy grid_resolution {self.grid_resolution} (a grid of up to "
+                     f"{self.grid_resolution}^3 voxels)", float(self.grid_resolution) ** 3, GRID_VOXEL_BYTES,
+                     "use a coarser --grid-resolution (default 64)")
         if not math.isfinite(self.grid_margin_m) or self.grid_margin_m < 0:
             raise ValueError(f"occupancy grid_margin_m must be >= 0, got {self.grid_margin_m!r}")

@@ -6,9 +6,11 @@ counters. A checkpoint is a plain dict of tensors, numbers, strings and containe
 them (nothing that needs pickle's arbitrary code): the run's config as JSON,
 the state dicts of the loss module (actor, twin critics, targets), optimisers
 and replay buffer, the counters, the random states of torch, NumPy and Python,
-and, for a one-worker run, the env's runtime state. Loading a truncated or
-foreign file, or one whose config the run cannot continue, raises
-`CheckpointError` naming the file and the reason.
+and, for a one-worker run, the env's runtime state. Every file carries the SHA-256 of its tensors
+(`nbv.rl.archive`), checked on load after its zip entries' sizes and CRCs.
+Loading a truncated, corrupt or foreign file, or one whose config the run
+cannot continue, raises `CheckpointError` naming the file and the reason; a
+file written before the checksum (its CRCs still checked) loads with a warning.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from __future__ import annotations
 import json
 import pickle
 import random
+import warnings
 import zipfile
 from pathlib import Path
 from typing import Any
@@ -24,6 +27,7 @@ import numpy as np
 import torch
 
 from common.io import atomic_path
+from nbv.rl.archive import CHECKSUM_KEY, ArchiveError, check_archive, nonfinite_weights, tensor_checksum
 from nbv.rl.config import upgrade_record
 
 FORMAT = "nbv-sac-checkpoint"
@@ -68,8 +72,9 @@ def seed_everything(seed: int) -> None:
 def save_checkpoint(path: str | Path, state: dict[str, Any], kind: str = FORMAT) -> Path:
     """Write `state` (tagged with format `kind` and version) atomically to `path`."""
     path = Path(path)
+    doc = {"format": kind, "version": VERSION, **state}
     with atomic_path(path) as tmp:
-        torch.save({"format": kind, "version": VERSION, **state}, tmp)
+        torch.save({**doc, CHECKSUM_KEY: tensor_checksum(doc)}, tmp)
     return path
 
 
@@ -79,7 +84,10 @@ def load_checkpoint(path: str | Path, kinds: tuple[str, ...] = (FORMAT,)) -> dic
     if not path.is_file():
         raise CheckpointError(f"checkpoint {path} not found")
     try:
+        check_archive(path)
         state = torch.load(path, map_location="cpu", weights_only=True)
+    except ArchiveError as err:
+        raise CheckpointError(f"checkpoint {path}: {err}") from err
     except (RuntimeError, EOFError, OSError, zipfile.BadZipFile, pickle.UnpicklingError, ValueError) as err:
         raise CheckpointError(f"checkpoint {path} is corrupt or not a checkpoint: {err}") from err
     if not isinstance(state, dict) or state.get("format") not in kinds:
@@ -93,7 +101,19 @@ def load_checkpoint(path: str | Path, kinds: tuple[str, ...] = (FORMAT,)) -> dic
     missing = [key for key in required if key not in state]
     if missing:
         raise CheckpointError(f"checkpoint {path} lacks {', '.join(missing)}")
+    _check_checksum(state, path)
     return state
+
+
+def _check_checksum(state: dict[str, Any], path: Path) -> None:
+    """Refuse a file whose tensors differ from the checksum it carries; warn for one written without."""
+    stored = state.get(CHECKSUM_KEY)
+    if stored is None:
+        warnings.warn(f"checkpoint {path} carries no tensor checksum (written before the toolkit stored "
+                      f"one); its zip CRCs were checked. Re-save it to add one", stacklevel=3)
+    elif stored != tensor_checksum(state):
+        raise CheckpointError(f"checkpoint {path} is corrupt: its tensors do not match the checksum it "
+                              f"carries (damaged bytes?); use an intact copy")
 
 
 def save_policy(path: str | Path, config: str, loss_state: dict[str, Any], counters: dict[str, int]) -> Path:
@@ -123,6 +143,11 @@ def load_policy(path: str | Path) -> tuple[dict[str, Any], dict[str, torch.Tenso
     else:
         loss = state["loss"]
         weights = actor_weights(loss) if isinstance(loss, dict) else loss
+    bad = nonfinite_weights(weights) if isinstance(weights, dict) else []
+    if bad:
+        raise CheckpointError(f"checkpoint {path}: actor weights {', '.join(bad[:3])}"
+                              f"{' and more' if len(bad) > 3 else ''} hold NaN or infinite values "
+                              f"(a diverged run?); use an earlier checkpoint")
     return config, weights
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import open3d as o3d
@@ -11,7 +12,8 @@ import pytest
 
 from render.camera import UAVCamera
 from render.capture import capture_dataset
-from render.colmap import ExportConfig, export_dataset, world_to_camera
+from render.colmap import ExportConfig, build_model, export_dataset, world_to_camera
+from render.dataset import read_dataset
 from render.scan import CirclePlan, circle_scan
 from render.settings import RenderSettings
 from render.viewpoint import opencv_to_opengl
@@ -110,3 +112,16 @@ def test_world_to_camera_is_colmaps_convention():
     c2w[:3, 3] = [1.0, 2.0, 3.0]
     q, t = world_to_camera(c2w)
     assert q.tolist() == [1.0, 0.0, 0.0, 0.0] and t.tolist() == [-1.0, -2.0, -3.0]
+
+
+@pytest.mark.parametrize("name", ["00\n02.png", "00 02.png", "00\t02.png"])
+def test_image_name_with_newline_or_space_refused_by_colmap_export(scan, tmp_path, name):
+    """A name the reader would refuse (a newline) or COLMAP's text format cannot hold (a space) is refused
+    before anything is written, whoever built the dataset."""
+    dataset = read_dataset(scan)
+    frame = dataset.frames[2]
+    odd = tmp_path / name
+    odd.write_bytes(frame.rgb_path.read_bytes())
+    frames = (*dataset.frames[:2], replace(frame, rgb_path=odd), *dataset.frames[3:])
+    with pytest.raises(ValueError, match="COLMAP's images.txt cannot hold the image name"):
+        build_model(replace(dataset, frames=frames), 0, 0)

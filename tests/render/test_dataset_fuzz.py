@@ -7,6 +7,7 @@ dataset whose every frame, pose and centre reads back valid; never another excep
 from __future__ import annotations
 
 import json
+import math
 import shutil
 import struct
 import zlib
@@ -117,7 +118,7 @@ PROBE_CASES = {
     "S8_string_in_matrix": (_set("frames.0.transform_matrix.0.0", "1"), "must be a number"),
     "S8_string_viewpoint": (_set("frames.0.nbv.viewpoint.0", "2"), "must be a number"),
     "S8_string_near": (_set("nbv.near_m", "0.05"), "nbv.near_m must be a number"),
-    "S9_center_nan": (_set("nbv.center", [float("nan"), 0, 0]), r"nbv.center\[0\] is NaN"),
+    "S9_center_nan": (_set("nbv.center", [float("nan"), 0, 0]), r"field nbv.center\[0\] is a bare NaN token"),
     "S9_center_null": (_set("nbv.center", None), "nbv.center must be a list"),
     "S11_frame_nbv_string": (_set("frames.0.nbv", ""), r"frames\[0\]\.nbv must be an object"),
     "S5_absolute_path": (_set("frames.1.file_path", "/etc/passwd"), "must be a relative path inside"),
@@ -185,6 +186,127 @@ def test_s10_images_that_are_not_what_they_claim_are_refused(base, tmp_path, kin
         read_dataset(root).rgb(1)
 
 
+def _text_edit(root: Path, old: str, new: str) -> None:
+    path = root / "transforms.json"
+    text = path.read_text()
+    assert old in text
+    path.write_text(text.replace(old, new, 1))
+
+
+@pytest.mark.parametrize("old, new, key", [
+    ('"w": 32', '"w": 16, "w": 32', "'w'"),
+    ('"frames": [', '"frames": [], "frames": [', "'frames'"),
+    ('"fl_x": ', '"fl_x": 1000.0, "fl_x": ', "'fl_x'")])
+def test_duplicate_json_key_refused(base, tmp_path, old, new, key):
+    root = _copy(base, tmp_path / "ds")
+    _text_edit(root, old, new)
+    with pytest.raises(DatasetError, match=f"transforms.json: key {key} appears twice in one object"):
+        read_dataset(root)
+
+
+@pytest.mark.parametrize("token", ["NaN", "Infinity", "-Infinity"])
+def test_bare_nan_token_refused_anywhere(base, tmp_path, token):
+    root = _copy(base, tmp_path / "ds")
+    _text_edit(root, '"nbv": {', f'"aabb_scale": {token}, "nbv": {{"extra": [{token}], ')
+    message = rf"transforms.json: field frames\[0\]\.aabb_scale is a bare {token} token, which is not JSON"
+    with pytest.raises(DatasetError, match=message):
+        read_dataset(root)
+
+
+def test_dataset_writer_never_writes_nan(tmp_path):
+    """A NaN or infinity reaching transforms.json (here a frame's own field) is refused, not written as a
+    bare token: the reader refuses those, and so do strict parsers elsewhere."""
+    camera = UAVCamera(*SIZE)
+    view = Viewpoint(2.0, 0.0, 0.3)
+    with pytest.raises(ValueError, match="transforms.json: cannot write a NaN or infinite number as JSON"):
+        with DatasetWriter(tmp_path / "ds", camera, {"center": CENTER}) as writer:
+            writer.add(np.zeros((SIZE[1], SIZE[0], 3), np.uint8), np.ones(SIZE[::-1], np.float32),
+                       viewpoint_to_c2w(view, np.array(CENTER)), view, {"extra": -math.inf})
+    assert not (tmp_path / "ds").exists()
+
+
+def _png_chunks_of(data: bytes) -> list[tuple[bytes, bytes]]:
+    chunks, pos = [], 8
+    while pos < len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        chunks.append((kind, data[pos + 8:pos + 8 + length]))
+        pos += 12 + length
+    return chunks
+
+
+def _png_of(chunks: list[tuple[bytes, bytes]]) -> bytes:
+    return b"\x89PNG\r\n\x1a\n" + b"".join(struct.pack(">I", len(body)) + kind + body
+                                          + struct.pack(">I", zlib.crc32(kind + body))
+                                          for kind, body in chunks)
+
+
+@pytest.mark.parametrize("folder, row_bytes", [("images", SIZE[0] * 3 + 1), ("depth", SIZE[0] * 2 + 1)])
+def test_png_with_short_image_data_refused(base, tmp_path, folder, row_bytes):
+    root = _copy(base, tmp_path / "ds")
+    path = root / folder / "0001.png"
+    chunks = _png_chunks_of(path.read_bytes())
+    raw = zlib.decompress(b"".join(body for kind, body in chunks if kind == b"IDAT"))
+    assert len(raw) == SIZE[1] * row_bytes  # the hand-worked size: a filter byte per row
+    half = zlib.compress(raw[:row_bytes * SIZE[1] // 2])  # a valid stream holding the first 12 rows
+    path.write_bytes(_png_of([c for c in chunks if c[0] not in (b"IDAT", b"IEND")]
+                             + [(b"IDAT", half), (b"IEND", b"")]))
+    ds = read_dataset(root)
+    with pytest.raises(DatasetError, match=f"{folder}/0001.png: truncated PNG image data: "
+                                           f"{row_bytes * 12} of the {row_bytes * 24} bytes"):
+        ds.rgb(1) if folder == "images" else ds.depth(1)
+
+
+def test_interlaced_png_reads_back(base, tmp_path):
+    """An Adam7 PNG written by hand (seven passes, filter 0 on every row) is read whole."""
+    root = _copy(base, tmp_path / "ds")
+    image = read_dataset(root).rgb(2)
+    adam7 = ((0, 0, 8, 8), (4, 0, 8, 8), (0, 4, 4, 8), (2, 0, 4, 4), (0, 2, 2, 4), (1, 0, 2, 2), (0, 1, 1, 2))
+    passes = [image[y0::dy, x0::dx] for x0, y0, dx, dy in adam7]
+    raw = b"".join(b"\0" + row.tobytes() for rows in passes if rows.shape[1] for row in rows)
+    header = struct.pack(">IIBBBBB", SIZE[0], SIZE[1], 8, 2, 0, 0, 1)
+    (root / "images" / "0002.png").write_bytes(_png_of([(b"IHDR", header), (b"IDAT", zlib.compress(raw)),
+                                                        (b"IEND", b"")]))
+    assert np.array_equal(read_dataset(root).rgb(2), image)
+
+
+def test_frames_sharing_an_image_with_different_poses_refused(base, tmp_path):
+    root = _copy(base, tmp_path / "ds")
+    _edit(root, lambda doc: doc["frames"].append(dict(doc["frames"][0])))  # an identical repeat passes
+    assert len(read_dataset(root)) == 4
+    _edit(root, lambda doc: doc["frames"][1].update(file_path="images/0000.png",
+                                                    depth_file_path="depth/0000.png"))
+    with pytest.raises(DatasetError, match=r"frames\[0\] and frames\[1\] name the same file .*0000.png"
+                                           r".*with different poses"):
+        read_dataset(root)
+
+
+def test_animated_png_refused(base, tmp_path):
+    root = _copy(base, tmp_path / "ds")
+    path = root / "images" / "0000.png"
+    still = Image.open(path).convert("RGB")
+    still.save(path, save_all=True, append_images=[Image.new("RGB", still.size)], default_image=True)
+    assert b"acTL" in path.read_bytes()
+    with pytest.raises(DatasetError, match="0000.png: animated PNG .APNG, chunk acTL. is not supported"):
+        read_dataset(root).rgb(0)
+
+
+def test_lone_surrogate_in_file_path_refused(base, tmp_path):
+    root = _copy(base, tmp_path / "ds")
+    _text_edit(root, '"images/0001.png"', '"images/0001\\ud800.png"')
+    with pytest.raises(DatasetError, match=r"frames\[1\]\.file_path contains a lone surrogate"):
+        read_dataset(root)
+
+
+@pytest.mark.parametrize("char", ["\n", "\r", "\t", "\x1b", "\x85"])
+def test_control_character_in_image_name_refused(base, tmp_path, char):
+    root = _copy(base, tmp_path / "ds")
+    name = f"images/00{char}02.png"
+    (root / "images" / "0002.png").rename(root / name)
+    _edit(root, _set("frames.2.file_path", name))
+    with pytest.raises(DatasetError, match=r"frames\[2\]\.file_path contains a control character"):
+        read_dataset(root)
+
+
 def test_dataset_folders_follow_the_umask(base):
     assert base.stat().st_mode & 0o777 == 0o777 & ~current_umask()
 
@@ -218,10 +340,11 @@ def _mutate_json(doc: dict, rng: np.random.Generator, outside: Path) -> None:
 
 
 def _mutate_text(root: Path, rng: np.random.Generator) -> None:
-    """Damage transforms.json as text: deep nesting, truncation, a flipped byte, another encoding."""
+    """Damage transforms.json as text: deep nesting, truncation, a flipped byte, another encoding, a key
+    twice, a bare NaN."""
     path = root / "transforms.json"
     data = bytearray(path.read_bytes())
-    action, pos = int(rng.integers(4)), int(rng.integers(len(data)))
+    action, pos = int(rng.integers(6)), int(rng.integers(len(data)))
     if action == 0:
         key = data.index(b'"frames": [') if rng.integers(2) else data.index(b'"nbv": {')
         nested = _deep(int(rng.choice([900, 5000, 100_000]))).encode()
@@ -230,8 +353,12 @@ def _mutate_text(root: Path, rng: np.random.Generator) -> None:
         del data[pos:]
     elif action == 2:
         data[pos] ^= 1 << int(rng.integers(8))
-    else:
+    elif action == 3:
         data = bytearray(data.decode().encode(["utf-16", "utf-8-sig", "utf-32"][int(rng.integers(3))]))
+    else:
+        key = [b'"w": ', b'"fl_x": ', b'"frames": ', b'"center": '][int(rng.integers(4))]
+        extra = b"NaN, " if action == 4 else [b"-Infinity, ", b"Infinity, "][int(rng.integers(2))]
+        data = data.replace(key, key + extra + key, 1)
     path.write_bytes(bytes(data))
 
 
@@ -240,9 +367,15 @@ def _mutate_png(root: Path, rng: np.random.Generator) -> None:
     folder = ["images", "depth"][int(rng.integers(2))]
     path = root / folder / f"{int(rng.integers(3)):04d}.png"
     data = bytearray(path.read_bytes())
-    action = int(rng.integers(7))
+    action = int(rng.integers(9))
     if action == 0:
         path.write_bytes(bytes(data[:int(rng.integers(len(data)))]))
+    elif action in (7, 8):  # image data short of its rows (valid stream and CRCs), or an APNG chunk
+        chunks = _png_chunks_of(bytes(data))
+        raw = zlib.decompress(b"".join(body for kind, body in chunks if kind == b"IDAT"))
+        tail = ([(b"IDAT", zlib.compress(raw[:int(rng.integers(len(raw)))]))] if action == 7
+                else [(b"acTL", struct.pack(">II", 2, 0))] + [c for c in chunks if c[0] == b"IDAT"])
+        path.write_bytes(_png_of([chunks[0], *tail, (b"IEND", b"")]))
     elif action == 1:
         for pos in rng.integers(0, len(data), int(rng.integers(1, 8))):
             data[pos] ^= int(rng.integers(1, 256))

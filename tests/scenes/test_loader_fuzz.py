@@ -6,7 +6,12 @@ finite target; never another exception and never a NumPy warning.
 
 from __future__ import annotations
 
+import io
+import os
+import struct
+import threading
 import warnings
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -174,3 +179,141 @@ def test_fuzzed_meshes_give_named_errors_or_valid_targets(tmp_path, fresh_cache)
             counts["named"] += 1
     print(f"loader fuzz: {CASES} cases, {counts['named']} named errors, {counts['valid']} valid, 0 other")
     assert counts["named"] + counts["valid"] == CASES and min(counts.values()) > 20
+
+
+TRIANGLE_OBJ = "v 0 0 0\nv 2 0 0\nv 0 1 3\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n"
+
+
+def _load_within(path: Path, seconds: float = 30.0):
+    """`load_file_scene(path)` in a thread: its result or exception, failing the test if it blocks."""
+    outcome: dict = {}
+
+    def run():
+        try:
+            outcome["scene"] = load_file_scene(path, ground=False)
+        except Exception as err:  # noqa: BLE001 - handed to the test to judge
+            outcome["error"] = err
+    worker = threading.Thread(target=run, daemon=True)
+    worker.start()
+    worker.join(seconds)
+    assert not worker.is_alive(), f"loading {path} blocked for {seconds} s"
+    return outcome
+
+
+@pytest.mark.parametrize("named", ["mtllib", "map_Kd"])
+def test_fifo_named_as_mtllib_or_texture_refused_without_blocking(tmp_path, fresh_cache, named):
+    os.mkfifo(tmp_path / "fifo")
+    mtl = "fifo" if named == "mtllib" else "m.mtl"
+    (tmp_path / "m.mtl").write_text("newmtl a\nKd 1 1 1\nmap_Kd fifo\n")
+    (tmp_path / "model.obj").write_text(f"mtllib {mtl}\nusemtl a\n{TRIANGLE_OBJ}")
+    error = _load_within(tmp_path / "model.obj").get("error")
+    assert isinstance(error, ValueError) and "model.obj: it names 'fifo', which is not a regular file" in str(
+        error), error
+
+
+def test_oversized_texture_file_refused_unread(tmp_path, fresh_cache):
+    with open(tmp_path / "tex.png", "wb") as handle:  # a 2 GB sparse file: nothing written, nothing read
+        handle.truncate(2 * 10**9)
+    (tmp_path / "m.mtl").write_text("newmtl a\nmap_Kd tex.png\n")
+    (tmp_path / "model.obj").write_text(f"mtllib m.mtl\nusemtl a\n{TRIANGLE_OBJ}")
+    with pytest.raises(ValueError, match="model.obj: it names 'tex.png' of 2000000000 bytes, more than"):
+        load_file_scene(tmp_path / "model.obj")
+
+
+@pytest.mark.parametrize("suffix", [".obj", ".ply", ".stl"])
+def test_zero_total_area_refused(tmp_path, suffix):
+    """The box's 8 corners with every face repeating a vertex: a size, but no area to see."""
+    box = trimesh.creation.box((2.0, 1.0, 3.0))
+    flat = trimesh.Trimesh(box.vertices, np.stack([box.faces[:, 0], box.faces[:, 0], box.faces[:, 1]], 1),
+                           process=False)
+    flat.export(tmp_path / f"flat{suffix}")
+    with pytest.raises(ValueError, match=f"flat{suffix}: the target mesh has no area"):
+        load_file_scene(tmp_path / f"flat{suffix}")
+
+
+def test_collinear_triangles_refused(tmp_path):
+    lines = [f"v {i} {2 * i} {3 * i}" for i in range(102)]
+    lines += [f"f {i} {i + 1} {i + 2}" for i in range(1, 101)]
+    (tmp_path / "line.obj").write_text("\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match="line.obj: the target mesh has no area"):
+        load_file_scene(tmp_path / "line.obj")
+
+
+def test_negative_obj_indices_resolved(tmp_path):
+    """Relative indices after interleaved `v` lines count back from each face line (the OBJ spec), so the
+    two triangles keep their own corners: hand-worked, z from 0 to 2, normalised by the extent 2."""
+    (tmp_path / "rel.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n"
+                                      "v 0 0 2\nv 1 0 2\nv 0 1 2\nf -3 -2 -1\n")
+    scene = load_file_scene(tmp_path / "rel.obj", ground=False)
+    triangles = np.concatenate([p.vertices[p.faces] for p in scene.parts])
+    expected = (np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 0, 2], [1, 0, 2], [0, 1, 2]]])
+                - [0.5, 0.5, 0.0]) / 2.0
+    got = sorted(map(tuple, triangles.reshape(-1, 3).round(9)))
+    assert got == sorted(map(tuple, expected.reshape(-1, 3)))
+    (tmp_path / "before.obj").write_text("v 0 0 0\nv 1 0 0\nf -3 -2 -1\nv 0 1 0\n")
+    with pytest.raises(ValueError, match="before.obj: line 3: face index -3 reaches before the first v"):
+        load_file_scene(tmp_path / "before.obj")
+
+
+def _glb_with_png(tmp_path: Path, png: bytes) -> Path:
+    box = trimesh.creation.box((2.0, 1.0, 3.0))
+    image = Image.fromarray(np.full((8, 8, 3), 200, np.uint8))
+    box.visual = trimesh.visual.TextureVisuals(uv=np.random.default_rng(1).random((len(box.vertices), 2)),
+                                               image=image)
+    glb = trimesh.exchange.gltf.export_glb(trimesh.Scene(box))
+    buffer = io.BytesIO()
+    image.save(buffer, format="PNG")
+    original = buffer.getvalue()
+    assert glb.count(original) == 1 and len(png) == len(original)  # same length: offsets stay valid
+    path = tmp_path / "tex.glb"
+    path.write_bytes(glb.replace(original, png))
+    return path
+
+
+def _huge_png_header(length: int) -> bytes:
+    """A PNG signature and an IHDR claiming 30000 x 30000 (CRC right), padded to `length`."""
+    body = struct.pack(">IIBBBBB", 30000, 30000, 8, 2, 0, 0, 0)
+    head = b"\x89PNG\r\n\x1a\n" + struct.pack(">I", 13) + b"IHDR" + body + struct.pack(">I", zlib.crc32(
+        b"IHDR" + body))
+    return head + bytes(length - len(head))
+
+
+@pytest.mark.parametrize("kind", ["huge_header", "random_bytes"])
+def test_corrupt_embedded_texture_reported(tmp_path, fresh_cache, kind):
+    buffer = io.BytesIO()
+    Image.fromarray(np.full((8, 8, 3), 200, np.uint8)).save(buffer, format="PNG")
+    length = len(buffer.getvalue())
+    png = (_huge_png_header(length) if kind == "huge_header"
+           else bytes(np.random.default_rng(2).integers(0, 256, length, dtype=np.uint8)))
+    with pytest.raises(ValueError, match="tex.glb: a texture cannot be used"):
+        load_file_scene(_glb_with_png(tmp_path, png))
+
+
+def test_corrupt_texture_file_reported(tmp_path, fresh_cache):
+    (tmp_path / "tex.jpg").write_bytes(b"\xff\xd8\xff" + bytes(np.random.default_rng(3).integers(
+        0, 256, 500, dtype=np.uint8)))
+    (tmp_path / "m.mtl").write_text("newmtl a\nmap_Kd tex.jpg\n")
+    (tmp_path / "model.obj").write_text(f"mtllib m.mtl\nusemtl a\n{TRIANGLE_OBJ}")
+    with pytest.raises(ValueError, match="model.obj: a texture cannot be used .failed to load image"):
+        load_file_scene(tmp_path / "model.obj")
+
+
+def test_mtl_options_before_map_kd_file_parsed(tmp_path, fresh_cache):
+    image = np.zeros((8, 8, 3), np.uint8)
+    image[:, :, 0] = 255
+    Image.fromarray(image).save(tmp_path / "my tex.png")
+    options = "-s 2 2 1 -o 0.5 0.5 0 -clamp off"
+    (tmp_path / "m.mtl").write_text(f"newmtl a\nKd 1 1 1\nmap_Kd {options} my tex.png\n")
+    (tmp_path / "model.obj").write_text(f"mtllib m.mtl\nusemtl a\n{TRIANGLE_OBJ}")
+    (part,) = load_file_scene(tmp_path / "model.obj", ground=False).parts
+    assert part.material.texture is not None and part.material.texture.parent.name == "mesh_textures"
+    assert np.array_equal(np.asarray(Image.open(part.material.texture)), image)
+
+
+def test_ply_declared_counts_exceed_body_refused(tmp_path):
+    text = _box_ply().replace("element face 12", "element face 10000000")
+    assert "element face 10000000" in text
+    (tmp_path / "short.ply").write_text(text)
+    with pytest.raises(ValueError, match="short.ply: its header declares 10000008 element lines .* its body "
+                                         "holds 20"):
+        load_file_scene(tmp_path / "short.ply")

@@ -105,3 +105,74 @@ def test_dataset_without_frames_names_the_file_and_field(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "transforms.json: field frames is empty" in err, err
     assert not (tmp_path / "rec").exists()
+
+
+def _one_line_naming(capsys, *words: str) -> str:
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "Traceback" not in err and all(w in err for w in words), err
+    return err
+
+
+@pytest.mark.parametrize(("argv", "words"), [
+    (PLAN + ["--planner", "circle", "--views", "2", "--metric-points", "1000000000000"],
+     ("--metric-points", "GiB", "use fewer points")),
+    (PLAN + ["--planner", "infogain", "--views", "2", "--grid-resolution", "100000"],
+     ("grid_resolution 100000", "GiB", "--grid-resolution")),
+    (PLAN + ["--planner", "circle", "--views", "1000000000"], ("views must lie in [1, 100000]",)),
+    (PLAN + ["--planner", "circle", "--views", "90000", "--width", "16384", "--height", "16384"],
+     ("views 90000 at 16384x16384", "GiB", "--views")),
+], ids=["metric_points_1e12", "grid_resolution_1e5", "plan_views_1e9", "plan_views_by_memory"])
+def test_memory_sized_values_bounded_before_allocation(argv, words, tmp_path, capsys):
+    assert main([a.replace("{tmp}", str(tmp_path)) for a in argv]) == 2
+    _one_line_naming(capsys, *words)
+    assert not (tmp_path / "plan").exists()
+
+
+def test_memory_bound_follows_this_machines_memory(monkeypatch):
+    """The bound is half the physical memory: 10^6 metric points pass with 1 GiB, not with 256 MiB."""
+    from common import memory
+    from nbv.recon.config import MetricsConfig
+
+    monkeypatch.setattr(memory, "physical_memory", lambda: 2**30)
+    assert MetricsConfig(n_points=1_000_000).n_points == 1_000_000
+    monkeypatch.setattr(memory, "physical_memory", lambda: 2**28)
+    with pytest.raises(memory.MemoryBoundError, match="0.238 GiB, more than 50% of this machine's 0.25 GiB"):
+        MetricsConfig(n_points=1_000_000)
+
+
+def test_many_frames_sharing_one_image_bounded_by_memory(tmp_path, capsys, monkeypatch):
+    """Frames naming one 32x24 image, scaled down (500 frames, a 256 MiB machine) from the probe's 10^5 on
+    16 GiB: refine refuses before extracting (262 MB of features at 500 a view, more than half the memory)
+    instead of growing past it."""
+    from common import memory
+
+    monkeypatch.setattr(memory, "physical_memory", lambda: 2**28)
+    source = write_circle_dataset(tmp_path / "ds", [0], size=(32, 24))
+    doc = json.loads((source / "transforms.json").read_text())
+    (source / "transforms.json").write_text(json.dumps({**doc, "frames": doc["frames"] * 500}))
+    assert main(["refine", str(source), "--out", str(tmp_path / "r")]) == 2
+    last = capsys.readouterr().err.replace("\r", "\n").strip().splitlines()[-1]  # after the progress bar
+    assert last.startswith("nbv refine: error: refine of 500 views"), last
+    assert "0.244 GiB" in last and "--max-features" in last
+    assert not (tmp_path / "r").exists()
+
+
+def test_tiny_voxel_size_refused(tmp_path, capsys):
+    source = write_circle_dataset(tmp_path / "ds", [0, 1], size=(32, 24))
+    assert main(["reconstruct", str(source), "--out", str(tmp_path / "rec"), "--voxel-size-m", "1e-9"]) == 2
+    _one_line_naming(capsys, "voxel_size_m must be at least 0.0001 m")
+    assert not (tmp_path / "rec").exists()
+
+
+@pytest.mark.parametrize(("argv", "words"), [
+    (SCAN + ["--seed", "1e3"], ("--seed must be a whole number", "'1e3'")),
+    (SCAN + ["--width", "0x40"], ("--width must be a whole number", "'0x40'")),
+    (SCAN + ["circle", "--views", "8.5"], ("--views must be a whole number", "'8.5'")),
+    (PLAN + ["--seed", "-5"], ("seed must be >= 0",)),
+    (["export", "{tmp}/ds", "--out", "{tmp}/e", "--seed", "-5"], ("seed must be >= 0",)),
+], ids=["scan_seed_1e3", "scan_width_hex", "scan_views_fraction", "plan_seed_negative",
+                                  "export_seed_negative"])
+def test_int_parse_errors_name_the_option(argv, words, tmp_path, capsys):
+    (tmp_path / "ds").mkdir()
+    assert main([a.replace("{tmp}", str(tmp_path)) for a in argv]) == 2
+    _one_line_naming(capsys, *words)

@@ -26,6 +26,7 @@ from common.provenance import run_record
 from nbv.recon.config import HeatmapConfig, MetricsConfig
 from nbv.recon.heatmap import write_heatmap
 from nbv.recon.metrics import Geometry, SurfaceMetrics, evaluate_surfaces, load_geometry
+from render.captures.open import refuse_folder
 from scenes import list_scenes, load_scene
 from scenes.normalise import up_to_z
 from scenes.spec import MeshOrientation
@@ -91,6 +92,8 @@ def evaluate(config: EvaluateConfig) -> dict[str, SurfaceMetrics]:
         raise ValueError("give --reference, --gt or both to compare against")
     out = Path(config.out)
     check_output_folder(out, config.overwrite, OUTPUTS)
+    refuse_folder(config.mesh, "MESH")
+    refuse_folder(config.reference, "--reference")
     prediction = load_geometry(config.mesh, "mesh")
     references: dict[str, Geometry] = {}
     if gt.gt is not None:

@@ -29,6 +29,8 @@ NO_POINT = -1
 """point3D id of an observation without a 3D point (2^64 - 1 in the binary files)."""
 MAX_MODEL_BYTES = 4 * 2**30
 """Largest model file read."""
+MAX_COORD = 1e9
+"""Largest absolute camera translation accepted (geo-registered models reach 1e7 m)."""
 
 
 @dataclass(frozen=True)
@@ -116,6 +118,10 @@ def check_image(image: Image, where: Path) -> Image:
     pose = (*image.qvec, *image.tvec)
     if not all(math.isfinite(v) for v in pose):
         raise DatasetError(f"{where}: {record} has a NaN or infinite pose {pose}")
+    if any(abs(v) > MAX_COORD for v in image.tvec):
+        raise DatasetError(f"{where}: {record} has a translation beyond {MAX_COORD:g} {image.tvec}")
+    if not (0 <= image.image_id < 2**32 and 0 <= image.camera_id < 2**32):
+        raise DatasetError(f"{where}: {record} has an image or camera id outside [0, 2^32)")
     norm = math.sqrt(sum(q * q for q in image.qvec))
     if norm < 1e-9:
         raise DatasetError(f"{where}: {record} has a zero rotation quaternion")

@@ -67,6 +67,8 @@ def _camera(camera_id: int, model: str | int, width: int, height: int, params: l
         raise DatasetError(f"{where}: {record} has NaN or infinite parameters {params}")
     if width < 1 or height < 1:
         raise DatasetError(f"{where}: {record} has size {width}x{height}")
+    if not 0 <= camera_id < 2**32:
+        raise DatasetError(f"{where}: {record}'s id is outside [0, 2^32)")
     return Camera(camera_id, name, width, height, tuple(params))
 
 
@@ -114,8 +116,8 @@ def _binary_points(path: Path) -> Points:
 
 
 def _points(ids, xyz, rgb, error, tracks, path: Path) -> Points:
-    if any(pid >= 2**63 for pid in ids):
-        raise DatasetError(f"{path}: a point3D id is beyond 2^63")
+    if any(not 0 <= pid < 2**63 for pid in ids):
+        raise DatasetError(f"{path}: a point3D id is outside [0, 2^63)")
     return Points(np.array(ids, np.int64), np.array(xyz, np.float64).reshape(-1, 3),
                   np.array(rgb, np.uint8).reshape(-1, 3), np.array(error, np.float64), tuple(tracks))
 

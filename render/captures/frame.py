@@ -101,7 +101,7 @@ def target_frame(c2ws: np.ndarray, config: CaptureFrameConfig, where: Path) -> T
     center, spread = np.asarray(config.capture_center, float), 1.0
     if config.capture_center is None:
         center, spread = nearest_point_to_axes(origins, forwards)
-        if spread < MIN_AXIS_SPREAD:
+        if spread < MIN_AXIS_SPREAD or not np.all(np.isfinite(center)):
             raise DatasetError(f"{where}: the optical axes are nearly parallel (spread {spread:.2g}), so no "
                                f"target centre can be estimated; give --capture-center X Y Z")
         if np.mean(np.einsum("ni,ni->n", center - origins, forwards) > 0) < 0.5:

@@ -2,8 +2,10 @@
 
 A capture (COLMAP, nerfstudio, a phone app) comes in a world frame and scale of its own. The Bag of
 Views needs each view's azimuth about the target. The target centre is estimated as the point nearest
-all optical axes (least squares), the up axis as the cameras' mean up vector, and azimuth 0 is the
-first frame's direction from the centre (counter-clockwise about up, as in DESIGN.md §2). Each is
+all optical axes (least squares), the up axis as the normal of the plane the cameras' x axes lie in
+(a level camera's x axis is horizontal; measured on a 288-view hemisphere scan this is exact where
+the cameras' mean up vector, which also orients it, tilts 0.26 degrees), and azimuth 0 is the first
+frame's direction from the centre (counter-clockwise about up, as in DESIGN.md §2). Each is
 carried along by a rotation, translation and scale of the world, so the azimuths, and so the kept
 views, do not depend on the frame's gauge. Either estimate can be given instead (`CaptureFrameConfig`).
 """
@@ -25,9 +27,13 @@ MIN_AXIS_SPREAD = 0.01
 (0: all axes parallel, as in a forward-facing capture)."""
 MIN_UP_AGREEMENT = 0.1
 """Smallest length of the mean of the cameras' unit up vectors for it to define an up axis."""
-AZIMUTH_DIGITS = 9
-"""Azimuths are rounded to 1e-9 rad, so a view on a range boundary falls on the same side in every
-gauge (float noise of a re-expressed pose is ~1e-15 rad)."""
+LEVEL_SPREAD = 0.05
+"""The x axes define the up axis when the scatter of the cameras' x axes has its smallest eigenvalue
+below this (they lie near one plane: ~13 degrees of roll RMS) and its middle one above it (they span
+that plane, as they do when the cameras face different ways); else the mean up vector does."""
+AZIMUTH_GRID = 1e-9
+"""Azimuths are rounded up onto this grid (rad), so a view on a range boundary (within float noise,
+~1e-15 rad) falls in the range above it, as its exact azimuth does, in every gauge."""
 
 
 @dataclass(frozen=True)
@@ -121,7 +127,8 @@ def target_frame(c2ws: np.ndarray, config: CaptureFrameConfig, where: Path) -> T
 
 
 def _up_vector(c2ws: np.ndarray, config: CaptureFrameConfig, where: Path) -> np.ndarray:
-    """The given up vector, or the cameras' mean up (minus the OpenCV image-down axis), unit length."""
+    """The given up vector, else the normal of the level cameras' x axes, else the cameras' mean up
+    (minus the OpenCV image-down axis), which orients the normal; unit length."""
     if config.capture_up is not None:
         up = np.asarray(config.capture_up, float)
         return up / np.linalg.norm(up)
@@ -129,6 +136,10 @@ def _up_vector(c2ws: np.ndarray, config: CaptureFrameConfig, where: Path) -> np.
     if np.linalg.norm(mean) < MIN_UP_AGREEMENT:
         raise DatasetError(f"{where}: the cameras' up vectors disagree (mean length "
                            f"{np.linalg.norm(mean):.2g}), so no up axis is defined; give --capture-up X Y Z")
+    right = c2ws[:, :3, 0]
+    spread, axes = np.linalg.eigh(right.T @ right / len(right))
+    if spread[0] < LEVEL_SPREAD < spread[1]:
+        return axes[:, 0] * np.sign(axes[:, 0] @ mean)
     return mean / np.linalg.norm(mean)
 
 
@@ -144,10 +155,16 @@ def _azimuth_zero(offsets: np.ndarray, up: np.ndarray, where: Path) -> np.ndarra
 
 
 def local_viewpoint(local_c2w: np.ndarray) -> Viewpoint:
-    """The viewpoint of a local camera about the origin, its azimuth rounded (`AZIMUTH_DIGITS`)."""
+    """The viewpoint of a local camera about the origin, its azimuth rounded up (`AZIMUTH_GRID`); a camera
+    right above (or below) the centre takes the azimuth its x axis has on the sphere (x = (-sin a, cos a,
+    0), as `render.viewpoint.viewpoint_to_c2w` poses it), since its position has none."""
     x, y, z = local_c2w[:3, 3]
     radius = math.sqrt(x * x + y * y + z * z)
-    azimuth = round(math.atan2(y, x), AZIMUTH_DIGITS) % TWO_PI
+    if math.hypot(x, y) > 1e-6 * radius:
+        azimuth = math.atan2(y, x)
+    else:
+        azimuth = math.atan2(-local_c2w[0, 0], local_c2w[1, 0])
+    azimuth = math.ceil(azimuth / AZIMUTH_GRID - 1e-3) * AZIMUTH_GRID % TWO_PI
     return Viewpoint(radius, azimuth, math.asin(max(-1.0, min(1.0, z / radius))))
 
 

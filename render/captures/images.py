@@ -84,12 +84,10 @@ def read_image(path: Path, width: int, height: int) -> np.ndarray:
         raise DatasetError(f"{path}: not a JPEG or PNG image")
     try:
         with Image.open(io.BytesIO(data)) as img:
-            if img.size != (width, height):
-                raise DatasetError(f"{path}: image is {img.size[0]}x{img.size[1]}, its camera says "
-                                   f"{width}x{height}")
-            image = np.asarray(img.convert("RGB"))
+            size = img.size
+            image = np.asarray(img.convert("RGB")) if size == (width, height) else None
     except (OSError, ValueError, SyntaxError, Image.DecompressionBombError) as err:
-        if isinstance(err, DatasetError):
-            raise
         raise DatasetError(f"{path}: cannot decode JPEG: {err}") from err
+    if image is None:
+        raise DatasetError(f"{path}: image is {size[0]}x{size[1]}, its camera says {width}x{height}")
     return image

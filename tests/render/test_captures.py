@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pycolmap
@@ -14,10 +15,13 @@ from PIL import Image
 from synthetic import write_circle_dataset
 
 from nbv.cli import main
+from render.camera import UAVCamera
 from render.captures.dataset import CaptureDataset
-from render.captures.frame import CaptureFrameConfig
+from render.captures.frame import CaptureFrameConfig, local_viewpoint, target_frame
 from render.captures.open import read_views, write_kept
 from render.dataset import DatasetError, read_dataset
+from render.scan import hemisphere_scan
+from render.viewpoint import viewpoint_to_c2w
 
 CENTER = np.array([0.0, 0.0, 0.5])
 """write_circle_dataset's centre."""
@@ -157,3 +161,20 @@ def test_reconstruct_and_evaluate_say_a_capture_has_no_depth(captures, command, 
     err = capsys.readouterr().err
     assert "has no depth maps, and this command needs depth" in err and "Traceback" not in err
     assert not (tmp_path / "out").exists()
+
+
+def test_hemisphere_frame_is_exact_to_the_top_view():
+    """The 288 poses of the full scan in a similarity frame: the up axis from the level x axes is exact
+    (the mean up vector tilts by the top view's), and every azimuth, the top view's included, matches."""
+    views = hemisphere_scan(UAVCamera())
+    sim = similarity(9)
+    c2ws = np.stack([moved(viewpoint_to_c2w(v, CENTER), sim) for v in views])
+    target = target_frame(c2ws, CaptureFrameConfig(), Path("scan"))
+    np.testing.assert_allclose(target.up, sim[0] @ [0.0, 0.0, 1.0], atol=1e-12)
+    mean_up = -c2ws[:, :3, 1].mean(0)
+    assert np.degrees(np.arccos(mean_up @ target.up / np.linalg.norm(mean_up))) > 0.2
+    assert views[-1].elevation == pytest.approx(math.pi / 2)
+    for view, c2w in zip(views, c2ws):
+        mine = local_viewpoint(target.to_local(c2w))
+        assert abs((mine.azimuth - view.azimuth + math.pi) % (2 * math.pi) - math.pi) < 2e-9
+        assert mine.elevation == pytest.approx(view.elevation, abs=1e-9)

@@ -1,8 +1,9 @@
 """Measure how a scan re-expressed as other tools' captures refines against the scan itself (issue 27).
 
 Renders (or reuses from the scan cache) the full hemisphere scan of SCENE, writes it as COLMAP text,
-COLMAP binary, nerfstudio JPEG and nerfstudio JPEG with small OPENCV distortion and an off-centre
-principal point, each in a random similarity frame (the builders of tests/foreign_captures.py), runs
+COLMAP binary, nerfstudio PNG with an off-centre principal point (a 4 x 2 px crop), nerfstudio JPEG
+(quality 95) centred, the same off-centre, and off-centre with small OPENCV distortion, each in a
+random similarity frame (the builders of tests/foreign_captures.py), runs
 Alg. 1 on each for every (N, W) of the grid, and writes the Jaccard index of each capture's kept frames
 against the native scan's, per cell, as JSON and a markdown table.
 
@@ -53,6 +54,9 @@ def main() -> None:
         root = Path(tmp)
         captures = {"colmap-text": write_colmap(native, root / "text", "text", sim),
                     "colmap-binary": write_colmap(native, root / "binary", "binary", sim),
+                    "nerfstudio-png-offcentre": write_nerfstudio(native, root / "nsp", sim, crop=(4, 2, 0, 0),
+                                                                 suffix="png"),
+                    "nerfstudio-jpeg-centred": write_nerfstudio(native, root / "nsc", sim),
                     "nerfstudio-jpeg": write_nerfstudio(native, root / "ns", sim, crop=(4, 2, 0, 0)),
                     "nerfstudio-jpeg-distorted": write_nerfstudio(native, root / "nsd", sim, DISTORTION,
                                                                   (4, 2, 0, 0))}

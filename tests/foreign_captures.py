@@ -70,9 +70,10 @@ def write_colmap(dataset: ViewDataset, root: Path, kind: str, sim, coeffs=(0.0, 
 
 
 def write_nerfstudio(dataset: ViewDataset, root: Path, sim, coeffs=(0.0, 0.0, 0.0, 0.0),
-                     crop: tuple[int, int, int, int] = (0, 0, 0, 0), per_frame: bool = False) -> Path:
-    """ROOT/transforms.json and ROOT/images/*.jpg: OPENCV camera, JPEG quality 95, no depth; `crop`
-    (left, top, right, bottom pixels) moves the principal point off centre; `per_frame` puts the
+                     crop: tuple[int, int, int, int] = (0, 0, 0, 0), per_frame: bool = False,
+                     suffix: str = "jpg") -> Path:
+    """ROOT/transforms.json and ROOT/images/*.jpg (JPEG quality 95; or .png): OPENCV camera, no depth;
+    `crop` (left, top, right, bottom pixels) moves the principal point off centre; `per_frame` puts the
     intrinsics in every frame (Polycam's layout)."""
     (root / "images").mkdir(parents=True)
     k = dataset.camera.K
@@ -84,9 +85,10 @@ def write_nerfstudio(dataset: ViewDataset, root: Path, sim, coeffs=(0.0, 0.0, 0.
     crop_k = np.array([[k[0, 0], 0, k[0, 2] - left], [0, k[1, 1], k[1, 2] - top], [0, 0, 1]])
     frames = []
     for i, frame in enumerate(dataset.frames):
-        name = f"images/frame_{i + 1:05d}.jpg"
+        name = f"images/frame_{i + 1:05d}.{suffix}"
         view = dataset.rgb(i)[top:dataset.camera.height - bottom, left:dataset.camera.width - right]
-        Image.fromarray(distorted(np.ascontiguousarray(view), crop_k, coeffs)).save(root / name, quality=95)
+        image = Image.fromarray(distorted(np.ascontiguousarray(view), crop_k, coeffs))
+        image.save(root / name, **({"quality": 95} if suffix == "jpg" else {}))
         entry = {"file_path": name, "transform_matrix": opencv_to_opengl(moved(frame.c2w, sim)).tolist()}
         frames.append({**entry, **camera} if per_frame else entry)
     doc = {**({} if per_frame else camera), "frames": frames,

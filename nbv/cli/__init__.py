@@ -31,6 +31,7 @@ COMMANDS = {
     "evaluate": Command("evaluate", "Chamfer, Hausdorff, coverage and F-score, with a heat map"),
     "train": Command("train", "train the SAC next-best-view policy (resumes a run folder)"),
     "plan": Command("plan", "plan a scan with a planner, reconstruct it and score it"),
+    "mission": Command("mission", "write a plan's views as a UAV mission: QGroundControl .plan or KML"),
     "compare": Command("compare", "compare planners over seeds on one scene (table and bar chart)"),
     "online": Command("online", "the shipped policy against the baselines on held-out buildings"),
     "plot-training": Command("plot_training", "overlay the learning curves of training runs"),

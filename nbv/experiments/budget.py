@@ -13,7 +13,10 @@ interrupted run resumes; a new commit measures afresh). Each plan, then each
 plan's prefix scoring, is a unit of work (`nbv.fanout`), so `--workers` /
 `--ray` spread them.
 The area under each curve is the mean coverage over the budget range
-(trapezoid rule, `coverage_auc`).
+(trapezoid rule, `coverage_auc`). Beside coverage: the metres flown and the
+azimuth reversals at each budget, the coverage within each flight budget in
+metres, and coverage against metres (`nbv.experiments.budget_flight`,
+budget_metres.png).
 """
 
 from __future__ import annotations
@@ -27,12 +30,13 @@ from tyro.conf import arg
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import config_record, git_commit, run_cache
+from nbv.experiments.budget_flight import METRES, flight_markdown, flight_tables
 from nbv.experiments.planner_study import PlannerStudy, StudyRun, run_study
 from nbv.fanout.config import ExecutorConfig
 from nbv.planning.config import PlanSettings
 from nbv.planning.registry import budget_planners, replanned
 from nbv.recon.config import MetricsConfig
-from nbv.viz.paper import plot_budget_curves
+from nbv.viz.paper import plot_budget_curves, plot_coverage_metres
 
 BUDGETS = (5, 9, 13, 20)
 """View budgets of the curve (the paper's Fig. 1 count, 13, among them)."""
@@ -42,7 +46,7 @@ config's default is read when it is made, so a planner registered later joins it
 bound."""
 REPLANNED = tuple(name for name in replanned() if name in PLANNERS)
 """Planners whose shorter plans are not prefixes of their longer ones: planned at every budget."""
-OUTPUTS = ("budget.md", "budget.json", "budget.png")
+OUTPUTS = ("budget.md", "budget.json", "budget.png", "budget_metres.png")
 """What a budget study writes into its `out` together."""
 RUNS = "{scene}/{planner}-v{views}-seed{seed}"
 """A budget run's folder in the study's cache folder."""
@@ -65,6 +69,8 @@ class BudgetConfig:
     """Seeds per planner and building."""
     budgets: tuple[int, ...] = BUDGETS
     """View budgets, ascending."""
+    metres: tuple[float, ...] = METRES
+    """Flight budgets, metres along the viewing shell, ascending: the coverage reached within each."""
     settings: Annotated[PlanSettings, arg(name="")] = SETTINGS
     """What every plan shares (`nbv plan`'s settings; fusion and scoring of every plan and prefix too)."""
     executor: ExecutorConfig = ExecutorConfig()
@@ -75,6 +81,8 @@ class BudgetConfig:
             raise ValueError("a budget study needs at least one scene, planner, seed and budget")
         if list(self.budgets) != sorted(set(self.budgets)) or self.budgets[0] < 1:
             raise ValueError(f"budgets must be distinct, ascending and >= 1, got {self.budgets}")
+        if not self.metres or list(self.metres) != sorted(set(self.metres)) or self.metres[0] <= 0:
+            raise ValueError(f"metres (flight budgets) must be distinct, ascending, > 0, got {self.metres}")
 
     def study(self, runs: Path) -> PlannerStudy:
         """The budget curves as a planner study whose runs live in `runs` (`RUNS`)."""
@@ -113,18 +121,21 @@ def study_curves(runs: list[StudyRun], measure: str) -> dict[tuple[str, str], li
 
 
 def run_budget(config: BudgetConfig) -> dict[str, list[dict[str, Any]]]:
-    """Every planner's curves on every building and seed; writes budget.{md,json,png}; returns the rows per
-    measure (building, planner, per-budget mean and std in %, AUC)."""
-    cache = run_cache("budget", config, unkeyed=("out", "scenes", "planners", "seeds", "executor"))
+    """Every planner's curves on every building and seed; writes budget.{md,json,png} and budget_metres.png;
+    returns the rows per measure (building, planner, per-budget mean and std in %, AUC)."""
+    cache = run_cache("budget", config, unkeyed=("out", "scenes", "planners", "seeds", "executor", "metres"))
     runs = run_study(config.study(cache))
     curves = {measure: study_curves(runs, measure) for measure, _ in MEASURES}
     rows = {measure: budget_rows(curves[measure], config.budgets) for measure, _ in MEASURES}
+    flight = flight_tables(runs, curves["coverage"], config.metres)
     record = config_record(config, omit=("executor",))
     with atomic_folder(config.out, overwrite=True, outputs=OUTPUTS) as out:
-        write_text(out / "budget.md", budget_markdown(rows, config))
+        write_text(out / "budget.md", budget_markdown(rows, config)
+                   + flight_markdown(flight, config.budgets, config.metres))
         plot_budget_curves(rows, config.budgets, out / "budget.png")
+        plot_coverage_metres(rows["coverage"], flight["flight_m"], out / "budget_metres.png")
         write_json(out / "budget.json", {
-            "commit": git_commit(), "config": record, "rows": rows,
+            "commit": git_commit(), "config": record, "rows": rows, "flight": flight,
             "curves": {m: {f"{s}/{p}": c for (s, p), c in by.items()} for m, by in curves.items()}})
     return rows
 

@@ -5,7 +5,7 @@ view budget): every run is an `nbv plan` run (`nbv.planning.plan.plan_scan`)
 under the same nested `PlanSettings`, so every `nbv plan` knob is a flag; the
 table gives views, coverage, Chamfer and Hausdorff distances against the
 full-scan reference and the ground truth, mean +- std over seeds (docs/rl.md
-§10). Example (paper_results/planners):
+§10), then the metres flown and the azimuth reversals (`nbv.flight`). Example (paper_results/planners):
 
     nbv compare alpine_chalet --views 13 --planners policy:runs/policy/checkpoint.pt random circle greedy \\
         --seeds 0 1 2 --out cmp
@@ -35,6 +35,7 @@ from nbv.experiments.paper_numbers import FIG1_NBV
 from nbv.experiments.planner_study import PlannerStudy, plan_units, reference_units, run_study
 from nbv.fanout.config import ExecutorConfig
 from nbv.fanout.task import Task
+from nbv.flight import prefix_flight
 from nbv.planning.config import PlanSettings
 from nbv.planning.registry import entries, planner_specs
 from nbv.viz.figures import plot_planner_comparison
@@ -93,6 +94,8 @@ COMPARED = (("coverage", "reference", 100.0, "coverage % (ref)"),
             ("hausdorff_cm", "gt", 1.0, "Hausdorff cm (gt)"))
 """Table columns: (metric, against, display scale, header). The paper's Fig. 1 compares with the full scan
 (`reference`); the same metrics against the ground-truth mesh (`gt`) follow."""
+FLOWN = (("flight_m", "{:.1f}", "flight m"), ("azimuth_reversals", "{:.1f}", "azimuth reversals"))
+"""The flight columns after them: (run key, format, header); `nbv.flight`, from the start view."""
 
 
 def comparison_tasks(config: CompareConfig) -> tuple[list[Task], list[Task]]:
@@ -112,7 +115,8 @@ def compare_planners(config: CompareConfig) -> str:
     for run in run_study(config.study()):
         doc = run.plan()
         runs.append({"planner": run.label, "seed": run.seed,
-                     **{k: doc[k] for k in ("views", "gt", "reference", "planning_s", "deciding_s")}})
+                     **{k: doc[k] for k in ("views", "gt", "reference", "planning_s", "deciding_s")},
+                     **prefix_flight(doc)})
     scene = config.scene.scene
     table = comparison_table(runs, scene, config.settings.metrics.threshold_cm)
     record = config_record(config, omit=("executor",))
@@ -128,18 +132,21 @@ def compare_planners(config: CompareConfig) -> str:
 
 def comparison_table(runs: list[dict], scene: str, threshold_cm: float) -> str:
     """A Markdown table, one row per planner (mean +- std over its runs), the paper's Fig. 1 last."""
-    header = ["planner", "views", *(label for *_, label in COMPARED)]
+    header = ["planner", "views", *(label for *_, label in COMPARED), *(label for *_, label in FLOWN)]
     lines = [f"Planners on {scene}: mean ± std over seeds; coverage within {threshold_cm:g} cm; "
-             "ref = the full 288-view scan's reconstruction, gt = the ground-truth mesh", "",
+             "ref = the full 288-view scan's reconstruction, gt = the ground-truth mesh; flight: metres "
+             "along the viewing shell from the start view through the views in order", "",
              "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for planner in dict.fromkeys(r["planner"] for r in runs):
         mine = [r for r in runs if r["planner"] == planner]
         cells = [f"{planner} ({len(mine)} seeds)", _mean_std([r["views"] for r in mine], "{:.1f}")]
         for metric, against, scale, _ in COMPARED:
             cells.append(_mean_std([scale * r[against][metric] for r in mine], "{:.2f}"))
+        cells += [_mean_std([r[key] for r in mine], fmt) for key, fmt, _ in FLOWN]
         lines.append("| " + " | ".join(cells) + " |")
     paper = [f"{scale * FIG1_NBV[metric]:.2f}" if against == "reference" else "-"
              for metric, against, scale, _ in COMPARED]
+    paper += ["-"] * len(FLOWN)  # the paper counts no flight
     lines.append("| paper Fig. 1 (SAC policy, vs 288-view scan) | 13 | " + " | ".join(paper) + " |")
     return "\n".join(lines) + "\n"
 

@@ -162,7 +162,7 @@ def online_half(config: DemoConfig, folder: Path) -> dict[str, dict[str, Any]]:
     """The policy's one pass around `online_scene`, then random views at its count: `nbv plan` runs."""
     policy = run_study(online_study(config, folder, "policy", config.policy, None))[0].plan()
     rand = run_study(online_study(config, folder, "random", "random", policy["views"]))[0].plan()
-    keep = ("views", "planning_s", "gt")
+    keep = ("views", "planning_s", "gt", "flight_m", "azimuth_reversals")
     return {"policy": {k: policy[k] for k in keep}, "random": {k: rand[k] for k in keep}}
 
 
@@ -214,10 +214,10 @@ def results_table(results: dict[str, Any], metrics: dict[str, dict[str, SurfaceM
     if results["online"]:
         scene = results["config"]["online_scene"]
         rows = [[name, run["views"], f"{run['planning_s']:.2f}", f"{run['gt']['chamfer_cm']:.3f}",
-                 f"{run['gt']['hausdorff_cm']:.3f}", f"{run['gt']['coverage']:.3f}"]
-                for name, run in results["online"].items()]
+                 f"{run['gt']['hausdorff_cm']:.3f}", f"{run['gt']['coverage']:.3f}", f"{run['flight_m']:.1f}",
+                 run["azimuth_reversals"]] for name, run in results["online"].items()]
         header = ["planner", "views", "planning (s)", "Chamfer vs gt (cm)", "Hausdorff vs gt (cm)",
-                  "coverage vs gt"]
+                  "coverage vs gt", "flight (m)", "azimuth reversals"]
         lines += [f"## Online half: {scene} (held out): the policy's one pass, random views at its count", "",
                   markdown_table(header, rows),
                   "Trajectory: online_policy/trajectory.png. Paper Fig. 7 (vs its full scan): "

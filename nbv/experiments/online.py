@@ -8,7 +8,8 @@ Two protocols per building, each an `nbv compare` folder (runs already there are
 
 `online.md` gives, per building and overall, the mean coverage of the true surface at 13 views
 and the policy's margins over random, circle and greedy Bag of Views with its planning speed-up
-over greedy (issue 11's acceptance figures), then the one-pass table. The buildings default to
+over greedy (issue 11's acceptance figures), the metres each planner flies and its azimuth
+reversals (`nbv.flight`), then the one-pass table. The buildings default to
 the held-out ones: nothing here trains or tunes anything.
 
 Every comparison is a `PlannerStudy` preset (`nbv.experiments.planner_study`) under the one nested
@@ -160,6 +161,9 @@ def online_report(budget: dict[str, dict[str, list[dict]]], one_pass: dict[str, 
              "policies act on their mode.", "",
              f"Re-run: `{rerun_command(config)}`", "",
              markdown_table(["building", *labels], rows), "",
+             "Flight per scan (m along the viewing shell from the start view through the views in order "
+             "/ azimuth reversals; `plan.json`'s `flight_m` / `azimuth_reversals`), mean over seeds:", "",
+             _flight_table(budget, labels), "",
              "Planning time per scan, s (all / without the simulated camera, i.e. loading the scene into "
              "the renderer and rendering the views flown to; `plan.json`'s `planning_s` / `deciding_s`): "
              + ", ".join(f"{label} {planning[label]:.2f} / {deciding[label]:.2f}" for label in labels), ""]
@@ -181,6 +185,21 @@ def online_report(budget: dict[str, dict[str, list[dict]]], one_pass: dict[str, 
     return "\n".join(lines) + "\n"
 
 
+def _flight_table(budget: dict[str, dict[str, list[dict]]], labels: list[str]) -> str:
+    rows, means = [], {label: [] for label in labels}
+    for scene, runs in budget.items():
+        row = [scene]
+        for label in labels:
+            flight = (float(np.mean([r["flight_m"] for r in runs[label]])),
+                      float(np.mean([r["azimuth_reversals"] for r in runs[label]])))
+            means[label].append(flight)
+            row.append(f"{flight[0]:.1f} / {flight[1]:.1f}")
+        rows.append(row)
+    overall = {label: np.mean(means[label], axis=0) for label in labels}
+    rows.append(["**mean**", *(f"**{overall[label][0]:.1f} / {overall[label][1]:.1f}**" for label in labels)])
+    return markdown_table(["building", *labels], rows)
+
+
 def _one_pass_table(one_pass: dict[str, dict[str, list[dict]]], policy: str) -> str:
     rows = []
     for scene, runs in one_pass.items():
@@ -189,12 +208,13 @@ def _one_pass_table(one_pass: dict[str, dict[str, list[dict]]], policy: str) -> 
                      f"{100 * np.mean(_values(mine, 'reference', 'coverage')):.1f}",
                      f"{np.mean(_values(mine, 'reference', 'hausdorff_cm')):.2f}",
                      f"{np.mean(_values(mine, 'reference', 'chamfer_cm')):.2f}",
-                     f"{100 * np.mean(_values(mine, 'gt', 'coverage')):.1f}"])
+                     f"{100 * np.mean(_values(mine, 'gt', 'coverage')):.1f}",
+                     f"{np.mean([r['flight_m'] for r in mine]):.1f}"])
     rows.append(["paper Fig. 1 (its training building)", FIG1_NBV["views"],
                  f"{100 * FIG1_NBV['coverage']:.1f}", f"{FIG1_NBV['hausdorff_cm']:.2f}",
-                 f"{FIG1_NBV['chamfer_cm']:.2f}", "-"])
+                 f"{FIG1_NBV['chamfer_cm']:.2f}", "-", "-"])
     for scene, fig7 in FIG7_GENERALISATION.items():
         rows.append([f"paper Fig. 7 ({scene})", "-", "-", f"{fig7['hausdorff_cm']:.2f}",
-                     f"{fig7['chamfer_cm']:.2f}", "-"])
+                     f"{fig7['chamfer_cm']:.2f}", "-", "-"])
     return markdown_table(["episode", "views", "coverage % (ref)", "Hausdorff cm (ref)", "Chamfer cm (ref)",
-                           "coverage % (gt)"], rows)
+                           "coverage % (gt)", "flight m"], rows)

@@ -263,7 +263,7 @@ INDEX = (
     Result("sec7.md", "table2.json", "Sec. VII summary from our Table 2 grid, our definition", "make tables"),
     Result("fig1_fig7.md", "fig1_fig7.json", "Fig. 1 and Fig. 7: the policy's one-pass episodes",
            "make tables"),
-    Result("budget/budget.md", "budget/budget.json", "coverage against view budget, every planner, AUC",
+    Result("budget/budget.md", "budget/budget.json", "coverage against view budget and metres flown, AUC",
            "make tables"),
     Result("online/online.md", "online/online.json", "the shipped policy against the baselines, 13 views, "
            "five held-out buildings", "nbv online (command in the file)"),

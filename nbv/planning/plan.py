@@ -4,7 +4,9 @@ Stages, each a verb: `choose_views` (the planner, in a `PlanningWorld`),
 `capture_dataset` (RGB-D views on disk), `reconstruct_dataset` (TSDF fusion),
 `evaluate` (`nbv evaluate`'s function, so `metrics.json` has its format)
 against the ground-truth mesh (`gt`) and against the full-scan reconstruction
-(`reference`, paper Sec. V-B), and the trajectory plot. The reference is
+(`reference`, paper Sec. V-B), the flight from the start view through the views in order along the
+viewing shell (`nbv.flight`: `flight_m`, `legs_m`, `azimuth_reversals` in plan.json) and the trajectory
+plot with the flown path. The reference is
 `--reference MESH` when given; otherwise the hemisphere scan of the same
 scene and camera (`render.scan_cache.full_scan`) is reconstructed once and
 cached beside that scan (docs/rl.md §10, docs/reconstruction.md). The output
@@ -24,10 +26,11 @@ import numpy as np
 from common.io import atomic_folder, check_output_folder, write_json
 from common.provenance import config_record, run_record
 from common.threads import chosen_threads, limit_torch_threads, worker_threads
+from nbv.flight import flight_record, shell_path
 from nbv.planning.base import Planner
 from nbv.planning.config import PlanConfig, PlanSettings
 from nbv.planning.registry import make_planner
-from nbv.planning.world import PlanningWorld
+from nbv.planning.world import PlanningWorld, start_view
 from nbv.recon.evaluate import EvaluateConfig, GroundTruth, write_evaluation
 from nbv.recon.metrics import load_geometry
 from nbv.recon.tsdf import reconstruct_dataset, save_reconstruction
@@ -123,7 +126,9 @@ def plan_scan(config: PlanConfig) -> dict:
     check_output_folder(out, config.overwrite)
     shared = config.settings
     planner = make_planner(config.planner, shared, config.seed)
-    views, plan_s, camera_s = choose_views(config, planner, planning_env_config(config, planner))
+    env_config = planning_env_config(config, planner)
+    views, plan_s, camera_s = choose_views(config, planner, env_config)
+    flight = flight_record(start_view(env_config, config.seed), views)
     scene = config.scene.load()
     settings = replace(shared.render, seed=config.seed)
     meta = {"planner": config.planner, "up_axis": config.scene.up_axis}
@@ -143,12 +148,13 @@ def plan_scan(config: PlanConfig) -> dict:
         results = write_evaluation(evaluation, load_geometry(folder / "mesh.ply", "mesh"), references, folder)
         doc = {"planner": config.planner, "scene": config.scene.scene, "views": len(views),
                "planning_s": plan_s, "deciding_s": plan_s - camera_s,
-               "viewpoints": [v.as_array().tolist() for v in views],
+               "viewpoints": [v.as_array().tolist() for v in views], **flight,
                **run_record("nbv plan", config),
                **{name: result.as_dict() for name, result in results.items()}}
         write_json(folder / "plan.json", doc)
         poses = np.stack([viewpoint_to_c2w(v, scene.center()) for v in views])
+        flown = shell_path(start_view(env_config, config.seed), views).points + scene.center()
         plot_trajectory(poses, scene.target_mesh(), folder / "trajectory.png",
-                        title=f"{config.planner} on {Path(config.scene.scene).name}: {len(views)} views",
-                        numbered=True)
+                        title=f"{config.planner} on {Path(config.scene.scene).name}: {len(views)} views, "
+                              f"{flight['flight_m']:.1f} m flown", numbered=True, flown=flown)
     return doc

@@ -20,13 +20,18 @@ import numpy as np
 
 from nbv.bov.bag import BagOfViews
 from nbv.features.source import ViewSource
-from render.viewpoint import draw_viewpoint
+from render.viewpoint import Viewpoint, draw_viewpoint
 
 if TYPE_CHECKING:
     from nbv.rl.config import EnvConfig
     from render.camera import UAVCamera
     from scenes.model import Scene
     from scenes.spec import SceneSpec
+
+
+def start_view(env: EnvConfig, seed: int) -> Viewpoint:
+    """The start view of a plan in `env` with `seed`: drawn as `NBVEnv` draws its first episode's start."""
+    return draw_viewpoint(env.low, env.high, np.random.default_rng(int(seed)))
 
 
 class PlanningWorld:
@@ -47,8 +52,7 @@ class PlanningWorld:
         self.source = source or ViewSource(env.camera, env.render, env.bov.feature_config(), env.obs_size,
                                            self.seed)
         self.source.select(self.scene)
-        rng = np.random.default_rng(self.seed)  # drawn as NBVEnv draws its first start
-        self.start = draw_viewpoint(self.low, self.high, rng)
+        self.start = start_view(env, self.seed)
 
     @property
     def target(self) -> Scene:

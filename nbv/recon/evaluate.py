@@ -10,6 +10,10 @@ Also writes DIR/heatmap.png and DIR/heatmap.ply: distances to the reference,
 or to the ground truth when no reference is given (skipped when MESH is a
 point cloud; docs/reconstruction.md §6). The files are swapped into DIR together
 (`common.io.atomic_folder`; other files in DIR are kept).
+
+`nbv evaluate` refuses (`nbv.recon.overlap.DisjointSurfaces`) a ground truth or reference whose bounding
+box misses the reconstruction's or whose size is over 5x apart from it: most often a raw scene file
+given where the normalised target was meant (`--normalise-gt` normalises it as `nbv plan` does).
 """
 
 from __future__ import annotations
@@ -26,6 +30,7 @@ from common.provenance import run_record
 from nbv.recon.config import HeatmapConfig, MetricsConfig
 from nbv.recon.heatmap import write_heatmap
 from nbv.recon.metrics import Geometry, SurfaceMetrics, evaluate_surfaces, load_geometry
+from nbv.recon.overlap import check_overlap
 from render.captures.open import refuse_folder
 from scenes import list_scenes, load_scene
 from scenes.normalise import up_to_z
@@ -33,6 +38,17 @@ from scenes.spec import MeshOrientation
 
 OUTPUTS = ("metrics.json", "heatmap.png", "heatmap.ply")
 """Files `nbv evaluate` writes into its output folder."""
+
+GT_FIX = ("A raw scene file where the normalised target was meant? Add --normalise-gt to normalise it as "
+          "`nbv plan` does (with its --up-axis), or give the normalised target: `nbv scene export SCENE "
+          "--out DIR` writes DIR/mesh.ply (a plan folder holds it as gt.ply).")
+"""How to mend a ground truth that does not overlap the reconstruction (`check_overlap`)."""
+NORMALISED_FIX = ("The ground truth is normalised: is the reconstruction of this scene, read with the same "
+                  "--up-axis?")
+"""How to mend a normalised ground truth (`--normalise-gt`) that does not overlap the reconstruction."""
+REFERENCE_FIX = ("A reference from another scene or frame? Give a reconstruction of the same normalised "
+                 "target (e.g. `nbv reconstruct` of its full scan).")
+"""How to mend a reference reconstruction that does not overlap the reconstruction."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -43,11 +59,16 @@ class GroundTruth(MeshOrientation):
     """Ground truth: a mesh or point-cloud file, read as is but turned z up per --up-axis (e.g. the
     normalised target `nbv scene export` writes), or a built-in scene name / random:SEED (its target
     mesh, no ground)."""
+    normalise_gt: bool = False
+    """Normalise a --gt mesh file as `nbv plan` and `nbv scan` normalise a scene file (z up per --up-axis,
+    centred, base on z = 0, largest side 1 m): give the scene file itself as ground truth."""
 
     def load(self) -> Geometry:
         """The ground-truth surface, z up."""
         if self.gt is None:
             raise ValueError("no ground truth given (--gt)")
+        if Path(self.gt).is_file() and self.normalise_gt:
+            return load_scene(self.gt, self.up_axis).target_mesh()
         if Path(self.gt).is_file():
             geometry = load_geometry(self.gt, "gt")
             if self.up_axis == "z":
@@ -98,8 +119,11 @@ def evaluate(config: EvaluateConfig) -> dict[str, SurfaceMetrics]:
     references: dict[str, Geometry] = {}
     if gt.gt is not None:
         references["gt"] = gt.load()
+        fix = NORMALISED_FIX if gt.normalise_gt else GT_FIX
+        check_overlap(prediction, references["gt"], f"--gt {gt.gt}", fix)
     if config.reference is not None:
         references["reference"] = load_geometry(config.reference, "reference")
+        check_overlap(prediction, references["reference"], f"--reference {config.reference}", REFERENCE_FIX)
     with atomic_folder(out, config.overwrite, OUTPUTS) as folder:
         return write_evaluation(config, prediction, references, folder)
 

@@ -46,36 +46,49 @@ def contact_sheet(dataset: ViewDataset, out: str | Path, max_views: int = 48, th
 
 
 def plot_trajectory(poses: np.ndarray, mesh: trimesh.Trimesh, out: str | Path, title: str = "",
-                    numbered: bool | None = None, labels: Sequence[str] | None = None) -> Path:
-    """Save a 3D plot and a top view of camera positions (with viewing directions) around the target.
+                    numbered: bool | None = None, labels: Sequence[str] | None = None,
+                    flown: np.ndarray | None = None) -> Path:
+    """Save `trajectory_figure` (the same arguments) to the PNG `out`."""
+    return save_figure(trajectory_figure(poses, mesh, title, numbered, labels, flown), out)
+
+
+def trajectory_figure(poses: np.ndarray, mesh: trimesh.Trimesh, title: str = "", numbered: bool | None = None,
+                      labels: Sequence[str] | None = None, flown: np.ndarray | None = None) -> Figure:
+    """A 3D plot and a top view of camera positions (with viewing directions) around the target.
 
     Args:
         poses: (N, 4, 4) camera-to-world matrices (OpenCV convention), in capture order.
         mesh: the target, drawn as a light surface.
-        out: PNG path.
         title: figure title.
         numbered: print each view's index; default: only when there are at most 40 views.
         labels: legend-free text per camera instead of its index.
+        flown: (M, 3) world positions of the path flown from the start view (`nbv.flight`), drawn instead
+            of straight lines between the views, its start marked; default: the straight lines.
     """
     poses = np.asarray(poses, dtype=np.float64)
     pos, fwd = poses[:, :3, 3], poses[:, :3, 2]
+    line = pos if flown is None else np.asarray(flown, dtype=np.float64)
     numbered = len(poses) <= 40 if numbered is None else numbered
     fig = Figure(figsize=(12, 5.5))
     ax3 = fig.add_subplot(1, 2, 1, projection="3d")
     ax3.plot_trisurf(mesh.vertices[:, 0], mesh.vertices[:, 1], mesh.vertices[:, 2], triangles=mesh.faces,
                      color="0.75", alpha=0.6, linewidth=0)
     order = np.linspace(0, 1, len(pos))
-    ax3.plot(*pos.T, color="0.4", linewidth=0.8)
+    ax3.plot(*line.T, color="0.4", linewidth=0.8)
     ax3.scatter(*pos.T, c=order, cmap="viridis", s=14, depthshade=False)
     ax3.quiver(*pos.T, *(0.25 * fwd).T, color="tab:red", linewidth=0.5, arrow_length_ratio=0.2)
-    radius = np.abs(pos).max()
+    radius = max(np.abs(pos).max(), np.abs(line).max())
     ax3.set(xlim=(-radius, radius), ylim=(-radius, radius), zlim=(0, radius), xlabel="x (m)",
             ylabel="y (m)", zlabel="z (m)", box_aspect=(1, 1, 0.5))
     ax3.set_title(f"{len(poses)} views (colour: capture order)")
     top = fig.add_subplot(1, 2, 2)
     footprint = mesh.vertices[:, :2]
     top.fill(*footprint[ConvexHull(footprint).vertices].T, color="0.75", label="target footprint")
-    top.plot(pos[:, 0], pos[:, 1], color="0.4", linewidth=0.8)
+    top.plot(line[:, 0], line[:, 1], color="0.4", linewidth=0.8, label="flown path" if flown is not None
+             else None)
+    if flown is not None:
+        top.plot(*line[0, :2], "k*", markersize=10, zorder=4, label="start view")
+        top.legend(fontsize=7, loc="upper right")
     sc = top.scatter(pos[:, 0], pos[:, 1], c=order, cmap="viridis", s=18, zorder=3)
     top.quiver(pos[:, 0], pos[:, 1], fwd[:, 0], fwd[:, 1], color="tab:red", scale=25, width=0.003)
     if numbered or labels is not None:
@@ -86,7 +99,7 @@ def plot_trajectory(poses: np.ndarray, mesh: trimesh.Trimesh, out: str | Path, t
     fig.colorbar(sc, ax=top, label="capture order (0 = first)")
     if title:
         fig.suptitle(title)
-    return save_figure(fig, out)
+    return fig
 
 
 def plot_planner_comparison(runs: Sequence[dict], paper: dict, out: str | Path, title: str = "") -> Path:

@@ -1,4 +1,5 @@
-"""Pictures of `make tables` beyond Table 2: coverage against view budget, and the one-pass episodes."""
+"""Pictures of `make tables` beyond Table 2: coverage against view budget and against metres flown, and
+the one-pass episodes."""
 
 from __future__ import annotations
 
@@ -31,6 +32,29 @@ def plot_budget_curves(rows: dict[str, Sequence[dict[str, Any]]], budgets: Seque
             ax.grid(alpha=0.3)
             ax.legend(fontsize=7)
     fig.suptitle("Coverage against view budget (oracle dashed: an upper bound)")
+    return save_figure(fig, out)
+
+
+def plot_coverage_metres(coverage: Sequence[dict[str, Any]], metres: Sequence[dict[str, Any]],
+                         out: str | Path) -> Path:
+    """Coverage % against metres flown for every planner, one point per view budget (error bars: one std
+    over seeds both ways), a panel per building and one for the mean over buildings; rows as
+    `plot_budget_curves` takes them, `metres` in the same order as `coverage`."""
+    scenes = list(dict.fromkeys(r["scene"] for r in coverage))
+    fig = Figure(figsize=(4.6 * len(scenes), 4.2))
+    axes = fig.subplots(1, len(scenes), squeeze=False)[0]
+    for ax, scene in zip(axes, scenes):
+        flown = {r["planner"]: r for r in metres if r["scene"] == scene}
+        for i, row in enumerate(r for r in coverage if r["scene"] == scene):
+            dashed = "--" if row["planner"] == "oracle" else "-"
+            metre = flown[row["planner"]]
+            ax.errorbar(metre["mean"], row["mean"], xerr=metre["std"], yerr=row["std"], marker="o", capsize=3,
+                        linestyle=dashed, color=f"C{i % 10}", label=row["planner"])
+        ax.set(xlabel="metres flown along the viewing shell", ylabel="coverage % of the true surface",
+               title=scene)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle("Coverage against metres flown, one point per view budget (oracle dashed: an upper bound)")
     return save_figure(fig, out)
 
 

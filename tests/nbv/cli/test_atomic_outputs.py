@@ -15,11 +15,16 @@ from synthetic import write_circle_dataset
 
 from common.io import atomic_folder, replace_folder
 from nbv.cli import main
+from nbv.flight import flight_record
 from render.camera import UAVCamera
 from render.dataset import DatasetWriter
 from render.raycast import DepthRaycaster
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes import load_scene
+
+FLIGHT = {"viewpoints": [[2.0, 1.0, 0.5]],
+          **flight_record(Viewpoint(2.0, 0.0, 0.5), [Viewpoint(2.0, 1.0, 0.5)])}
+"""A one-view flight record, as plan.json holds it (compare reads it)."""
 
 CAMERA = UAVCamera(64, 48)
 
@@ -294,7 +299,7 @@ def test_compare_interrupted_keeps_the_previous_comparison_and_the_runs(tmp_path
         (out / f"random-seed{seed}").mkdir(parents=True)
         (out / f"random-seed{seed}" / "plan.json").write_text(
             json.dumps({"views": 13, "gt": metrics, "reference": metrics, "planning_s": 0.0,
-                        "deciding_s": 0.0}))
+                        "deciding_s": 0.0, **FLIGHT}))
     monkeypatch.setattr("nbv.experiments.compare.plot_planner_comparison",
                         lambda runs, paper, path, title: Path(path).write_bytes(b"png"))
     config = CompareConfig(scene=SceneSpec(scene="alpine_chalet"), planners=("random",), seeds=(0,), out=out)

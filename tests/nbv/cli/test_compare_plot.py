@@ -8,6 +8,13 @@ import sys
 
 from PIL import Image
 
+from nbv.flight import flight_record
+from render.viewpoint import Viewpoint
+
+FLIGHT = {"viewpoints": [[2.0, 1.0, 0.5]],
+          **flight_record(Viewpoint(2.0, 0.0, 0.5), [Viewpoint(2.0, 1.0, 0.5)])}
+"""A one-view flight record, as plan.json holds it (compare reads it)."""
+
 
 def run_nbv(*args: str) -> subprocess.CompletedProcess:
     """`nbv ARGS` in a fresh process, as a user runs it."""
@@ -34,7 +41,7 @@ def test_compare_planners_reads_back_finished_runs(tmp_path):
         (tmp_path / f"circle-seed{seed}").mkdir()
         (tmp_path / f"circle-seed{seed}" / "plan.json").write_text(
             json.dumps({"views": 13, "gt": metrics, "reference": metrics, "planning_s": 0.0,
-                        "deciding_s": 0.0}))
+                        "deciding_s": 0.0, **FLIGHT}))
     done = run_nbv("compare", "alpine_chalet", "--planners", "circle", "--seeds", "0", "1",
                    "--out", str(tmp_path))
     assert done.returncode == 0, done.stderr

@@ -6,7 +6,9 @@ from dataclasses import replace
 import pytest
 from PIL import Image
 
+from common.io import cache_dir
 from nbv.experiments.budget import SETTINGS, BudgetConfig, budget_rows, coverage_auc, run_budget
+from nbv.experiments.budget_flight import METRES
 from nbv.recon.config import MetricsConfig
 from render.camera import UAVCamera
 from render.settings import RenderSettings
@@ -44,8 +46,29 @@ def test_a_sequential_plans_prefix_scores_as_its_shorter_plan(tmp_path):
     assert "| test_building | greedy |" in table and "| 2 views | 3 views | AUC |" in table
     with Image.open(tmp_path / "out" / "budget.png") as image:
         assert image.size[0] > 500
+    check_flight(doc, table)
+    with Image.open(tmp_path / "out" / "budget_metres.png") as image:
+        assert image.size[0] > 500
+
+
+def check_flight(doc, table):
+    """Each budget's metres are its plan's first legs; coverage within M metres is the best plan that fits."""
+    flight = {(r["scene"], r["planner"]): r["mean"] for r in doc["flight"]["flight_m"]}
+    runs = next(cache_dir().glob("budget/*/test_building/greedy-v3-seed0")).parent  # the 2- and 3-view study
+    three = json.loads((runs / "greedy-v3-seed0" / "plan.json").read_text())
+    assert flight["test_building", "greedy"] == pytest.approx([sum(three["legs_m"][:2]), three["flight_m"]])
+    circle = [json.loads((runs / f"circle-v{k}-seed0" / "plan.json").read_text())["flight_m"] for k in (2, 3)]
+    assert flight["test_building", "circle"] == pytest.approx(circle)
+    reached = {(r["scene"], r["planner"]): r["mean"] for r in doc["flight"]["within_m"]}
+    coverage = {(r["scene"], r["planner"]): r["mean"] for r in doc["rows"]["coverage"]}
+    for name, metres in flight.items():  # one seed: the best coverage among the plans flying <= M
+        assert reached[name] == pytest.approx([max([c for c, m in zip(coverage[name], metres) if m <= limit],
+                                                   default=0.0) for limit in METRES])
+    assert "## Flight (m) along the viewing shell" in table and "| <= 10 m | <= 20 m | <= 40 m |" in table
 
 
 def test_budgets_must_ascend():
     with pytest.raises(ValueError, match="ascending"):
         BudgetConfig(budgets=(13, 5))
+    with pytest.raises(ValueError, match="metres"):
+        BudgetConfig(metres=(20.0, 10.0))

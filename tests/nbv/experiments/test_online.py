@@ -15,11 +15,15 @@ def metrics(coverage: float, chamfer: float = 0.5, hausdorff: float = 5.0) -> di
     return {"coverage": coverage, "chamfer_cm": chamfer, "hausdorff_cm": hausdorff}
 
 
-def save_run(folder, views: int, coverage: float, planning_s: float) -> None:
+def save_run(folder, views: int, coverage: float, planning_s: float, legs: tuple[float, ...] = (2.0, 2.0),
+             azimuths: tuple[float, ...] = (1.0, 2.0)) -> None:
     folder.mkdir(parents=True)
+    flight = {"start_viewpoint": [2.0, 0.0, 0.5], "viewpoints": [[2.0, a, 0.5] for a in azimuths],
+              "legs_m": list(legs), "flight_m": sum(legs), "azimuth_reversals": 0}
     (folder / "plan.json").write_text(json.dumps({
         "views": views, "gt": metrics(coverage), "reference": metrics(coverage + 0.05, 0.8, 3.0),
-        "planning_s": planning_s + 1.0, "deciding_s": planning_s}))  # 1 s rendering the views flown to
+        "planning_s": planning_s + 1.0, "deciding_s": planning_s,  # 1 s rendering the views flown to
+        **flight}))
 
 
 def test_online_report_from_saved_runs(tmp_path):
@@ -32,7 +36,9 @@ def test_online_report_from_saved_runs(tmp_path):
         root = tmp_path / scene_folder(scene)
         for label, values in coverage.items():
             for seed in (0, 1):
-                save_run(root / "views13" / f"{label}-seed{seed}", 13, values[seed], planning[label])
+                turns = (1.0, 0.5) if label == "random" and seed == 1 else (1.0, 2.0)  # one turn back
+                save_run(root / "views13" / f"{label}-seed{seed}", 13, values[seed], planning[label],
+                         (2.0, 2.0 + seed + (scene == "random:5")), turns)
         for seed in (0, 1):
             save_run(root / "onepass" / f"policy-shipped-seed{seed}", 10 + seed, 0.75, 0.4)
     config = OnlineConfig(out=tmp_path, scenes=("alpine_chalet", "random:5"), seeds=(0, 1),
@@ -50,7 +56,9 @@ def test_online_report_from_saved_runs(tmp_path):
     assert spread in text
     assert "policy-shipped 1.50 / 0.50" in text
     row = next(line for line in text.splitlines() if line.startswith("| random:5 (policy-shipped)"))
-    assert row == "| random:5 (policy-shipped) | 10.5 | 80.0 | 3.00 | 0.80 | 75.0 |"
+    assert row == "| random:5 (policy-shipped) | 10.5 | 80.0 | 3.00 | 0.80 | 75.0 | 4.0 |"
+    assert "| random:5 | 5.5 / 0.0 | 5.5 / 0.0 | 5.5 / 0.5 | 5.5 / 0.0 | 5.5 / 0.0 |" in text  # m / reversals
+    assert "| **mean** | **5.0 / 0.0** | **5.0 / 0.0** | **5.0 / 0.5** | **5.0 / 0.0** |" in text
     assert "| paper Fig. 7 (alpine_chalet) | - | - | 9.47 | 1.01 | - |" in text
     assert (tmp_path / "online.md").read_text() == text
     saved = json.loads((tmp_path / "online.json").read_text())

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import replace
 
+import numpy as np
 import pytest
 
 from nbv.bov.config import BoVConfig
@@ -17,7 +19,7 @@ from nbv.rl.env import NBVEnv
 from render.camera import UAVCamera
 from render.dataset import read_dataset
 from render.settings import RenderSettings
-from render.viewpoint import Viewpoint
+from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes import load_scene
 from scenes.spec import SceneSet, SceneSpec
 
@@ -41,7 +43,25 @@ def test_nbv_plan_end_to_end(tmp_path, capsys):
     assert plan["views"] == 6 and len(plan["viewpoints"]) == 6 and plan["gt"] == metrics["gt"]
     assert (out / "trajectory.png").stat().st_size > 10_000 and (out / "mesh.ply").is_file()
     assert '"planner": "circle"' in capsys.readouterr().out
+    check_flight(plan)
     assert main(args) == 2  # refuses to overwrite without --overwrite
+
+
+def check_flight(plan: dict) -> None:
+    """plan.json's flight: from the seed's start view (default ranges) along the 6-view ring, no shorter
+    than the straight lines, the ring's legs its arcs."""
+    spans = np.array([1.0, 2 * math.pi, math.radians(75)])  # R 1.5-2.5 m, all azimuths, 5-80 degrees
+    start = Viewpoint(*(np.array([1.5, 0.0, math.radians(5)]) + np.random.default_rng(0).random(3) * spans))
+    assert plan["start_viewpoint"] == pytest.approx(start.as_array().tolist())
+    centre = np.zeros(3)
+    stops = np.stack([viewpoint_to_c2w(Viewpoint(*v), centre)[:3, 3]
+                      for v in [plan["start_viewpoint"], *plan["viewpoints"]]])
+    straight = np.linalg.norm(np.diff(stops, axis=0), axis=1)
+    assert plan["flight_m"] >= straight.sum() and np.all(np.array(plan["legs_m"]) >= straight)
+    assert plan["flight_m"] == pytest.approx(sum(plan["legs_m"])) and len(plan["legs_m"]) == 6
+    ring_arc = 2.0 * math.cos(math.radians(42.5)) * math.pi / 3  # R cos(elevation) * 60 degrees
+    assert plan["legs_m"][1:] == pytest.approx([ring_arc] * 5, rel=1e-4)
+    assert plan["azimuth_reversals"] == 1  # the start (97 degrees) lies counter-clockwise of view 0
 
 
 @pytest.mark.parametrize("planner", ["oracle", "infogain"])
@@ -58,6 +78,8 @@ def test_nbv_plan_with_the_oracle_and_information_gain(planner, tmp_path, capsys
     assert ("reference" in plan) == (planner == "oracle")
     assert plan["planner"] == planner and plan["views"] == 3 and len(read_dataset(out / "views")) == 3
     assert 0.0 < plan["gt"]["coverage"] <= 1.0 and 0.0 <= plan["deciding_s"] <= plan["planning_s"]
+    if planner == "infogain":  # its first view is the start view: the recorded start is the planner's
+        assert plan["viewpoints"][0] == plan["start_viewpoint"] and plan["legs_m"][0] == 0.0
     settings = plan["config"]["settings"]
     assert settings["candidates"] == 2 and settings["occupancy"]["grid_resolution"] == 16
     assert f'"planner": "{planner}"' in capsys.readouterr().out

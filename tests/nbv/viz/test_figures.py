@@ -4,7 +4,13 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from nbv.viz.figures import contact_sheet, plot_training_curves, plot_trajectory, training_curves
+from nbv.viz.figures import (
+    contact_sheet,
+    plot_training_curves,
+    plot_trajectory,
+    training_curves,
+    trajectory_figure,
+)
 from render.camera import UAVCamera
 from render.dataset import DatasetWriter, read_dataset
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
@@ -35,6 +41,17 @@ def test_trajectory_plot_is_written(dataset, tmp_path):
     path = plot_trajectory(dataset.poses(), mesh, tmp_path / "t.png", "t")
     with Image.open(path) as img:
         assert img.size[0] > 800 and img.size[1] > 400
+
+
+def test_the_trajectory_draws_the_flown_path_not_the_chords(dataset):
+    mesh = load_scene("test_building").target_mesh()
+    poses = dataset.poses()
+    flown = np.stack([[2 * np.cos(a), 2 * np.sin(a), 0.5] for a in np.linspace(0, 3, 50)])
+    top = trajectory_figure(poses, mesh, flown=flown).axes[1]
+    drawn = {line.get_label(): np.column_stack(line.get_data()) for line in top.get_lines()}
+    assert np.allclose(drawn["flown path"], flown[:, :2]) and np.allclose(drawn["start view"], flown[:1, :2])
+    chords = trajectory_figure(poses, mesh).axes[1].get_lines()
+    assert [np.column_stack(line.get_data()).tolist() for line in chords] == [poses[:, :2, 3].tolist()]
 
 
 def test_training_curves_average_the_last_window(tmp_path):

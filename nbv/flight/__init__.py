@@ -1,0 +1,8 @@
+"""Flight: the path a UAV flies through a plan's views, its metres and its turn-backs."""
+
+from nbv.flight.path import FlightPath, azimuth_step, shell_path, shell_position
+from nbv.flight.record import FLIGHT_FIELDS, flight_record, prefix_flight
+from nbv.flight.reversals import azimuth_reversals
+
+__all__ = ["FLIGHT_FIELDS", "FlightPath", "azimuth_reversals", "azimuth_step", "flight_record",
+           "prefix_flight", "shell_path", "shell_position"]

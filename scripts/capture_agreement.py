@@ -74,8 +74,11 @@ def main() -> None:
     write_json(args.out / "captures.json", {
         "scene": args.scene, "views": len(native), "size": [args.width, args.height], "jaccard": jaccard,
         "native_kept": {f"{n},{w}": len(k) for (n, w), k in reference.items()}, "commit": git_commit()})
+    command = " ".join(["python", *sys.argv])
     write_text(args.out / "captures.md", f"# Kept-frame Jaccard of captures against the native scan "
-               f"({args.scene}, {len(native)} views, {args.width}x{args.height})\n\n{table}")
+               f"({args.scene}, {len(native)} views, {args.width}x{args.height})\n\n`{command}`; Alg. 1 with "
+               f"the default rule, seed 0; each capture in a random similarity frame; native kept views per "
+               f"cell in captures.json.\n\n{table}")
     print(table)
 
 

@@ -7,6 +7,7 @@ import json
 import math
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pycolmap
 import pytest
@@ -16,6 +17,8 @@ from synthetic import write_circle_dataset
 
 from nbv.cli import main
 from render.camera import UAVCamera
+from render.captures.colmap_capture import intrinsics
+from render.captures.colmap_model import Camera
 from render.captures.dataset import CaptureDataset
 from render.captures.frame import CaptureFrameConfig, local_viewpoint, target_frame
 from render.captures.open import read_views, write_kept
@@ -178,3 +181,17 @@ def test_hemisphere_frame_is_exact_to_the_top_view():
         mine = local_viewpoint(target.to_local(c2w))
         assert abs((mine.azimuth - view.azimuth + math.pi) % (2 * math.pi) - math.pi) < 2e-9
         assert mine.elevation == pytest.approx(view.elevation, abs=1e-9)
+
+
+@pytest.mark.parametrize(("model", "params"), [
+    ("SIMPLE_RADIAL", [90.0, 40.0, 30.0, 0.08]), ("RADIAL", [90.0, 40.0, 30.0, 0.08, -0.03]),
+    ("OPENCV", [90.0, 95.0, 40.0, 30.0, 0.08, -0.03, 0.002, -0.001]),
+    ("FULL_OPENCV", [90.0, 95.0, 40.0, 30.0, 0.08, -0.03, 0.002, -0.001, 0.01, 0.02, -0.01, 0.005])])
+def test_colmap_camera_models_map_to_opencv_as_colmap_projects(model, params):
+    """A point COLMAP's own camera model projects lands where OpenCV projects it with our intrinsics."""
+    camera = Camera(1, model, 80, 60, tuple(params))
+    intr = intrinsics(camera, Path("cameras.txt"))
+    rays = np.array([[0.1, -0.2, 1.0], [-0.3, 0.25, 1.0], [0.0, 0.0, 1.0]])
+    theirs = pycolmap.Camera(model=model, width=80, height=60, params=params).img_from_cam(rays)
+    ours = cv2.projectPoints(rays, np.zeros(3), np.zeros(3), intr.K, np.array(intr.distortion))[0][:, 0]
+    np.testing.assert_allclose(ours + 0.5, theirs, atol=1e-9)  # COLMAP's pixel centres sit at +0.5

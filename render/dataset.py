@@ -55,8 +55,8 @@ class Frame:
 
     rgb_path: Path
     """The sRGB PNG."""
-    depth_path: Path
-    """The uint16 millimetre depth PNG."""
+    depth_path: Path | None
+    """The uint16 millimetre depth PNG (None: a capture from another tool, which has no depth)."""
     c2w: np.ndarray
     """4x4 camera-to-world, OpenCV convention, float64."""
     viewpoint: Viewpoint | None = None

@@ -29,7 +29,10 @@ from nbv.bov.bag import BagOfViews
 from nbv.bov.config import BoVConfig, BoVRule
 from nbv.features.cache import dataset_features
 from nbv.features.sift import DESCRIPTOR_DIM, Features
-from render.dataset import ViewDataset, read_dataset, write_subset
+from render.captures.dataset import CaptureDataset
+from render.captures.frame import CaptureFrameConfig
+from render.captures.open import read_views, write_kept
+from render.dataset import ViewDataset
 from render.viewpoint import c2w_to_viewpoint
 
 FEATURE_BYTES = 2 * 4 * (DESCRIPTOR_DIM + 3)
@@ -45,7 +48,10 @@ class DatasetRun:
     """A run over a view dataset's features: what `nbv refine` and `nbv refine-sweep` share."""
 
     dataset: Annotated[Path, Positional, arg(metavar="DATASET")]
-    """A view dataset folder (transforms.json, images/, depth/), e.g. from `nbv scan`."""
+    """A view dataset folder (transforms.json, images/, depth/), e.g. from `nbv scan`, or a capture from
+    another tool: a COLMAP model (ROOT with images/ and sparse/0/) or a nerfstudio transforms.json folder."""
+    capture: CaptureFrameConfig = CaptureFrameConfig()
+    """The target frame of a capture from another tool (ignored for our datasets, which record theirs)."""
     seed: int = 0
     """Seed of the reservoir and k-means++ draws."""
     device: str = "cpu"
@@ -144,7 +150,7 @@ def load_views(run: DatasetRun, rule: BoVRule, progress: Progress | None = None
     """Read the run's dataset and its (cached) features and azimuths; fail clearly on an empty dataset."""
     if run.device.startswith("cuda") and int(run.device.partition(":")[2] or 0) >= torch.cuda.device_count():
         raise ValueError(f"device {run.device!r}: torch sees {torch.cuda.device_count()} CUDA GPU(s) here")
-    dataset = read_dataset(run.dataset)
+    dataset = read_views(run.dataset, run.capture)
     config = rule.feature_config(run.device)
     check_memory(f"refine of {len(dataset)} views of {run.dataset}", len(dataset),
                  config.max_features * FEATURE_BYTES, "refine fewer views or lower --max-features")
@@ -159,7 +165,8 @@ def _json_score(score: float) -> float | None:
 
 
 def refine_dataset(config: RefineConfig, progress: Progress | None = None) -> dict[str, Any]:
-    """Refine `config.dataset` into `config.out`: the kept views as a dataset, plus `refine.json`.
+    """Refine `config.dataset` into `config.out`: the kept views as a dataset in the input's format
+    (ours, a COLMAP model or a nerfstudio transforms.json), plus `refine.json`.
 
     `progress` is called with the number of views whose features were just extracted.
     Returns the summary written to `refine.json` (docs/data-formats.md §6): `kept` (source
@@ -177,10 +184,20 @@ def refine_dataset(config: RefineConfig, progress: Progress | None = None) -> di
                "ranges": result.ranges, "settings": settings,
                "seconds": round(time.perf_counter() - start, 3),
                "note": "scores: null is +inf (first view of an empty range); a view is kept iff score > 0",
-               **run_record("nbv refine", config)}
-    write_subset(dataset, result.kept, out, {"refine": {"source": str(config.dataset), **settings}},
-                 config.overwrite, extra={"refine.json": summary})
+               **capture_record(dataset), **run_record("nbv refine", config)}
+    write_kept(dataset, result.kept, out, {"refine": {"source": str(config.dataset), **settings}},
+               config.overwrite, extra={"refine.json": summary})
     return summary
+
+
+def capture_record(dataset: ViewDataset) -> dict[str, Any]:
+    """`capture`: a capture's format and target frame, and `frame_files`: each frame's image (relative
+    to the dataset) so kept indices can be traced; {} for our datasets."""
+    if not isinstance(dataset, CaptureDataset):
+        return {}
+    files = [str(f.rgb_path.relative_to(dataset.root)) if f.rgb_path.is_relative_to(dataset.root)
+             else str(f.rgb_path) for f in dataset.frames]
+    return {"capture": dataset.meta["capture"], "frame_files": files}
 
 
 def kept_view_grid(descriptors: Sequence[torch.Tensor], azimuths: Sequence[float], ranges: Sequence[int],

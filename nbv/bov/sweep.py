@@ -16,7 +16,7 @@ from typing import Any
 from common.io import atomic_folder, atomic_path, markdown_table, write_json, write_text
 from common.provenance import run_record
 from nbv.bov.config import BoVRule, check_size
-from nbv.bov.refine import DatasetRun, Progress, RefineResult, kept_view_grid, load_views
+from nbv.bov.refine import DatasetRun, Progress, RefineResult, capture_record, kept_view_grid, load_views
 
 PAPER_RANGES = (5, 7, 9, 11)
 """The N values of the paper's Table 2."""
@@ -64,7 +64,8 @@ def sweep(config: SweepConfig, progress: Progress | None = None,
     doc = {"dataset": str(config.dataset), "source_views": len(dataset), "grid": rows,
            "kept": {f"{n},{w}": r.kept for (n, w), r in grid.items()},
            "settings": config.settings(config.rule),
-           "seconds": round(time.perf_counter() - start, 3), **run_record("nbv refine-sweep", config)}
+           "seconds": round(time.perf_counter() - start, 3), **capture_record(dataset),
+           **run_record("nbv refine-sweep", config)}
     with atomic_folder(config.out, overwrite=True, outputs=OUTPUTS) as folder:  # the three files together
         write_csv(folder / "sweep.csv", rows)
         write_text(folder / "sweep.md", sweep_markdown(rows, str(config.dataset)))

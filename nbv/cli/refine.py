@@ -8,6 +8,7 @@ from tqdm import tqdm
 
 from nbv.bov.refine import RefineConfig, refine_dataset
 from nbv.cli.parse import parse
+from render.captures.frame import describe_frame
 
 
 def main(args: Sequence[str], prog: str) -> int:
@@ -15,6 +16,8 @@ def main(args: Sequence[str], prog: str) -> int:
     config = parse(RefineConfig, args, prog)
     with tqdm(desc="features", unit="view", leave=False) as bar:
         summary = refine_dataset(config, bar.update)
+    if "capture" in summary:
+        print(describe_frame(summary["capture"]))
     print(f"kept {summary['kept_views']} of {summary['source_views']} views "
           f"(N={config.bov.ranges}, W={config.bov.words}) in {summary['seconds']:.1f} s: {config.out}")
     return 0

@@ -8,6 +8,7 @@ from tqdm import tqdm
 
 from nbv.bov.sweep import SweepConfig, sweep, sweep_summary
 from nbv.cli.parse import parse
+from render.captures.frame import describe_frame
 
 
 def main(args: Sequence[str], prog: str) -> int:
@@ -17,5 +18,7 @@ def main(args: Sequence[str], prog: str) -> int:
     with (tqdm(desc="features", unit="view", leave=False) as features,
           tqdm(total=cells, desc="grid", unit="run", leave=False) as grid):
         doc = sweep(config, features.update, grid.update)
+    if "capture" in doc:
+        print(describe_frame(doc["capture"]))
     print(sweep_summary(doc))
     return 0

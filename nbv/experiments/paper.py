@@ -282,6 +282,8 @@ INDEX = (
            "term in the reward", "scripts/select_defaults.py --round 4"),
     Result("selection/round1/selection.md", "selection/round1/selection.json", "its first round, before the "
            "lattice fix", "scripts/select_defaults.py --round 1"),
+    Result("captures/captures.md", "captures/captures.json", "the full scan as COLMAP and nerfstudio "
+           "captures: kept-frame Jaccard against the scan's own", "scripts/capture_agreement.py"),
 )
 """Every result `README.md` may map, in its order."""
 SEED_KEYS = ("episode_seeds", "seeds")

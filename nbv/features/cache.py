@@ -41,6 +41,8 @@ def dataset_digest(dataset: ViewDataset) -> str:
     width, height = dataset.camera.width, dataset.camera.height
     for frame in dataset.frames:
         digest.update(image_bytes(frame.rgb_path, width, height))
+        if "undistort" in frame.meta:  # a capture's image is undistorted on reading: key its camera too
+            digest.update(json.dumps(frame.meta["undistort"]).encode())
         digest.update(b"\0")
     return digest.hexdigest()
 

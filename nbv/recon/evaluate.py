@@ -31,6 +31,7 @@ from nbv.recon.config import HeatmapConfig, MetricsConfig
 from nbv.recon.heatmap import write_heatmap
 from nbv.recon.metrics import Geometry, SurfaceMetrics, evaluate_surfaces, load_geometry
 from nbv.recon.overlap import check_overlap
+from render.captures.open import refuse_folder
 from scenes import list_scenes, load_scene
 from scenes.normalise import up_to_z
 from scenes.spec import MeshOrientation
@@ -112,6 +113,8 @@ def evaluate(config: EvaluateConfig) -> dict[str, SurfaceMetrics]:
         raise ValueError("give --reference, --gt or both to compare against")
     out = Path(config.out)
     check_output_folder(out, config.overwrite, OUTPUTS)
+    refuse_folder(config.mesh, "MESH")
+    refuse_folder(config.reference, "--reference")
     prediction = load_geometry(config.mesh, "mesh")
     references: dict[str, Geometry] = {}
     if gt.gt is not None:

@@ -17,6 +17,7 @@ from common.io import atomic_folder, check_output_folder, check_separate, write_
 from common.provenance import run_record
 from nbv.recon.config import ReconstructionConfig
 from nbv.recon.tsdf import reconstruct_dataset, save_reconstruction
+from render.captures.open import require_depth
 from render.dataset import read_dataset
 
 OUTPUTS = ("mesh.ply", "points.ply", "reconstruction.json")
@@ -44,6 +45,7 @@ def reconstruct(config: ReconstructConfig) -> dict[str, Any]:
     """Fuse the dataset, write the outputs and return the run summary written to reconstruction.json."""
     out = Path(config.out)
     check_output_folder(out, config.overwrite, OUTPUTS)
+    require_depth(config.dataset)
     dataset = read_dataset(config.dataset)
     start = time.perf_counter()
     recon = reconstruct_dataset(dataset, config.recon)

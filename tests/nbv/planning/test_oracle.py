@@ -2,47 +2,48 @@
 
 from __future__ import annotations
 
+import importlib.util
 import json
+from pathlib import Path
 
 import numpy as np
-import pytest
 
-from nbv.planning.config import PlanConfig, PlanSettings
+from nbv.planning.config import PlanSettings
 from nbv.planning.oracle import (
     POOL,
-    baseline_names,
     covered,
     greedy_cover,
     improve_by_swaps,
     lattice_viewpoints,
     ones,
 )
-from nbv.planning.plan import plan_scan
 from nbv.recon.config import MetricsConfig
 from nbv.rl.config import EnvConfig
 from render.camera import UAVCamera
 from render.settings import RenderSettings
 from render.viewpoint import Viewpoint
-from scenes.spec import SceneSet, SceneSpec
+from scenes.spec import SceneSet
 
-SETTINGS = PlanSettings(camera=UAVCamera(160, 120), render=RenderSettings(spp=1), full_scan=False,
+_SPEC = importlib.util.spec_from_file_location("oracle_bound",
+                                               Path(__file__).parents[3] / "scripts" / "oracle_bound.py")
+SCRIPT = importlib.util.module_from_spec(_SPEC)
+_SPEC.loader.exec_module(SCRIPT)
+
+SETTINGS = PlanSettings(camera=UAVCamera(64, 48), render=RenderSettings(spp=1), full_scan=False,
                         metrics=MetricsConfig(n_points=5000))
-"""The acceptance's small case: 160x120, scored on the ground truth only, 5000 metric points."""
+"""A small case: 64x48 (160x120: the script's default), scored on the ground truth only, 5000 points."""
 
 
-@pytest.mark.parametrize("views, seed", [(3, 0)])
-def test_the_oracle_is_at_least_every_budget_planner_through_nbv_plan(views, seed, tmp_path):
-    # Issue 26's acceptance point: each planner planned, captured, fused and scored by `nbv plan` itself.
-    scores = {}
-    for planner in (*baseline_names(), "oracle"):
-        config = PlanConfig(scene=SceneSpec(scene="test_building"), views=views, planner=planner, seed=seed,
-                            out=tmp_path / planner, settings=SETTINGS)
-        scores[planner] = plan_scan(config)["gt"]["coverage"]
-    assert {"random", "circle", "greedy", "infogain", "policy"} <= set(scores)
-    assert all(scores["oracle"] >= score for score in scores.values()), str(scores)
-    assert scores["oracle"] > min(scores.values()), str(scores)
-    plan = json.loads((tmp_path / "oracle" / "plan.json").read_text())
-    assert len(plan["viewpoints"]) == views
+def test_the_oracle_is_at_least_every_budget_planner_through_nbv_plan(tmp_path):
+    # Issue 26's acceptance point, by scripts/oracle_bound.py (160x120 there): each planner planned,
+    # captured, fused and scored by `nbv plan` itself.
+    rows = SCRIPT.bound_rows("test_building", SETTINGS, [3], [0], tmp_path)
+    coverage = rows[0]["coverage"]
+    assert {"random", "circle", "greedy", "infogain", "policy", "oracle"} <= set(coverage)
+    assert SCRIPT.bounded(rows) and all(coverage["oracle"] >= score for score in coverage.values()), rows
+    assert coverage["oracle"] > min(coverage.values()), rows
+    assert len(json.loads((tmp_path / "oracle-v3-seed0" / "plan.json").read_text())["viewpoints"]) == 3
+    assert not SCRIPT.bounded([{"coverage": {"oracle": 0.5, "random": 0.6}}])
 
 
 def test_the_lattice_holds_the_middle_ring():

@@ -18,10 +18,13 @@ from nbv.planning.oracle import (
     ones,
 )
 from nbv.recon.config import MetricsConfig
+from nbv.recon.fused_coverage import FusedCoverage
 from nbv.rl.config import EnvConfig
 from render.camera import UAVCamera
+from render.renderer import MitsubaRenderer
 from render.settings import RenderSettings
 from render.viewpoint import Viewpoint
+from scenes import load_scene
 from scenes.spec import SceneSet
 
 _SPEC = importlib.util.spec_from_file_location("oracle_bound",
@@ -42,7 +45,12 @@ def test_the_oracle_is_at_least_every_budget_planner_through_nbv_plan(tmp_path):
     assert {"random", "circle", "greedy", "infogain", "policy", "oracle"} <= set(coverage)
     assert SCRIPT.bounded(rows) and all(coverage["oracle"] >= score for score in coverage.values()), rows
     assert coverage["oracle"] > min(coverage.values()), rows
-    assert len(json.loads((tmp_path / "oracle-v3-seed0" / "plan.json").read_text())["viewpoints"]) == 3
+    plan = json.loads((tmp_path / "oracle-v3-seed0" / "plan.json").read_text())
+    assert len(plan["viewpoints"]) == 3
+    scene = load_scene("test_building")  # the oracle's in-memory score is nbv plan's number, to the bit
+    scorer = FusedCoverage(MitsubaRenderer(scene, SETTINGS.camera, SETTINGS.render), scene, SETTINGS.recon,
+                           SETTINGS.metrics, seed=0)
+    assert scorer.coverage([Viewpoint(*v) for v in plan["viewpoints"]]) == plan["gt"]["coverage"]
     assert not SCRIPT.bounded([{"coverage": {"oracle": 0.5, "random": 0.6}}])
 
 

@@ -7,16 +7,19 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from nbv.planning.config import PlanSettings
 from nbv.planning.oracle import (
     POOL,
+    CoverageOraclePlanner,
     covered,
     greedy_cover,
     improve_by_swaps,
     lattice_viewpoints,
     ones,
 )
+from nbv.planning.world import PlanningWorld
 from nbv.recon.config import MetricsConfig
 from nbv.recon.fused_coverage import FusedCoverage
 from nbv.rl.config import EnvConfig
@@ -52,6 +55,12 @@ def test_the_oracle_is_at_least_every_budget_planner_through_nbv_plan(tmp_path):
                            SETTINGS.metrics, seed=0)
     assert scorer.coverage([Viewpoint(*v) for v in plan["viewpoints"]]) == plan["gt"]["coverage"]
     assert not SCRIPT.bounded([{"coverage": {"oracle": 0.5, "random": 0.6}}])
+
+
+def test_the_oracle_refuses_a_world_off_the_plans_settings():
+    world = PlanningWorld(EnvConfig(scenes=SceneSet(scene=("test_building",)), camera=UAVCamera(64, 48)))
+    with pytest.raises(ValueError, match="differ from the plan's, so its scores would not be the report's"):
+        CoverageOraclePlanner(PlanSettings()).plan(world, 2)  # the plan's camera: 320x240
 
 
 def test_the_lattice_holds_the_middle_ring():

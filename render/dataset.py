@@ -103,7 +103,7 @@ class ViewDataset:
     def depth(self, index: int) -> np.ndarray:
         """Frame `index` as H x W float32 z-depth in metres (0: no hit)."""
         raw = read_png(self.frames[index].depth_path, self.camera.width, self.camera.height, depth=True)
-        return raw.astype(np.float32) * np.float32(DEPTH_SCALE)
+        return png_to_depth(raw)
 
 
 def depth_to_png(depth: np.ndarray) -> np.ndarray:
@@ -111,6 +111,16 @@ def depth_to_png(depth: np.ndarray) -> np.ndarray:
     mm = np.round(np.asarray(depth, dtype=np.float64) / DEPTH_SCALE)
     mm[(mm < 0) | (mm > np.iinfo(np.uint16).max) | ~np.isfinite(mm)] = 0
     return mm.astype(np.uint16)
+
+
+def png_to_depth(raw: np.ndarray) -> np.ndarray:
+    """A depth PNG's uint16 millimetres as H x W float32 metres (0: no hit)."""
+    return raw.astype(np.float32) * np.float32(DEPTH_SCALE)
+
+
+def stored_depth(depth: np.ndarray) -> np.ndarray:
+    """A rendered depth map as a dataset stores and reads it back: rounded to whole millimetres."""
+    return png_to_depth(depth_to_png(depth))
 
 
 class DatasetWriter:

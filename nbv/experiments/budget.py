@@ -106,7 +106,7 @@ def coverage_auc(budgets: tuple[int, ...], coverage: list[float]) -> float:
 
 
 MEASURES = (("coverage", "Coverage (%) of the true surface by the TSDF reconstruction"),
-            ("visible", "Visible coverage (%): true-surface samples some view sees (the oracle's measure)"))
+            ("visible", "Visible coverage (%): true-surface samples some view sees (an ideal sensor)"))
 """The study's measures: (key in scores.json, what it is)."""
 
 
@@ -163,8 +163,9 @@ def budget_markdown(rows: dict[str, list[dict]], config: BudgetConfig) -> str:
              f"Mean ± std over seeds {', '.join(map(str, config.seeds))} (the 'mean' rows: over buildings); "
              f"coverage within {config.settings.metrics.threshold_cm:g} cm. Sequential planners are scored "
              f"on prefixes of their {config.budgets[-1]}-view plan; {', '.join(REPLANNED)} plan afresh at "
-             "every budget. AUC: mean over the budget range (trapezoid rule). The oracle uses the true mesh "
-             "and maximises visible coverage: an upper bound of that measure, not a planner a user has."]
+             "every budget. AUC: mean over the budget range (trapezoid rule). The oracle uses the true mesh: "
+             "the best, on the TSDF coverage, of the other planners' sets and its own pick (at least each "
+             "of them there, by construction), not a planner a user has."]
     for measure, title in MEASURES:
         body = [[r["scene"], r["planner"], *(f"{m:.1f} ± {s:.1f}" for m, s in zip(r["mean"], r["std"])),
                  f"{r['auc']:.1f}"] for r in rows[measure]]

@@ -31,6 +31,7 @@ from nbv.fanout.task import Task
 from nbv.planning.config import PlanConfig, PlanSettings
 from nbv.planning.plan import plan_scan, reference_mesh
 from nbv.planning.registry import entry, planner_label
+from nbv.recon.fused_coverage import as_stored
 from nbv.recon.metrics import evaluate_surfaces, load_geometry
 from nbv.recon.tsdf import reconstruct_dataset
 from nbv.recon.visibility import scene_visibility
@@ -209,7 +210,7 @@ def score_run(folder: Path, views: tuple[int, ...], settings: PlanSettings, scen
               seed: int) -> None:
     """Write `folder/scores.json`: for each k in `views`, the coverage of the true surface by the first k
     views of the run in `folder`, as reconstructed (TSDF, within the metric threshold; the run's own score
-    at its full length) and as seen (the oracle's measure: the share of true-surface samples some view
+    at its full length) and as seen (an ideal sensor: the share of true-surface samples some view
     sees, `nbv.recon.visibility`)."""
     plan = json.loads((folder / "plan.json").read_text())
     target = scene.load()
@@ -221,7 +222,8 @@ def score_run(folder: Path, views: tuple[int, ...], settings: PlanSettings, scen
         if k == len(poses):
             covered = plan["gt"]["coverage"]
         else:
-            mesh = reconstruct_dataset(dataset, settings.recon, range(k)).mesh
+            # scored as its mesh.ply would be (float32), as `nbv plan` scores the full run
+            mesh = as_stored(reconstruct_dataset(dataset, settings.recon, range(k)).mesh)
             covered = evaluate_surfaces(mesh, {"gt": gt}, metrics)["gt"].coverage
         scores[str(k)] = {"coverage": covered, "visible": visibility.coverage(poses[:k])}
     write_json(folder / "scores.json", scores)

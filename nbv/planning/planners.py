@@ -18,10 +18,10 @@ planners by name in `registry.py`.
 - `InfoGainPlanner` (`infogain.py`): greedy on volumetric information gain,
   the unknown voxels a candidate would see in an occupancy grid built from the
   depth of the views flown to (model-free, geometric, no appearance).
-- `CoverageOraclePlanner` (`oracle.py`): the views that see the most of the
-  true surface among greedy's candidates and a fixed lattice (greedy with
-  restarts, then swaps); it uses the ground-truth mesh, so it is an upper-bound
-  reference, not a planner a real UAV could run.
+- `CoverageOraclePlanner` (`oracle.py`): the best, on the reported TSDF
+  coverage of the true surface, of every other budget planner's views and its
+  own greedy pick; it uses the ground-truth mesh, so it is an upper-bound
+  reference of those planners, not a planner a real UAV could run.
 - `PolicyPlanner` (`policy.py`): a trained SAC actor from the start view, acting on
   its distribution's mode (`policy:CHECKPOINT`, deterministic) or on seeded
   draws from it (`policy-sample:CHECKPOINT`, the max-entropy policy SAC

@@ -74,9 +74,11 @@ PLANNERS: tuple[PlannerEntry, ...] = (
                  "nbv.planning.policy:policy_planner", checkpoint=True),
     PlannerEntry("policy-sample", "the same, acting on seeded draws from the distribution",
                  "nbv.planning.policy:sampled_policy_planner", checkpoint=True, budget=False),
-    PlannerEntry("oracle", "the views among the start view, greedy's candidates and a 756-view lattice "
-                 "that see the most true surface (greedy from 8 starts, then swaps)",
-                 "nbv.planning.oracle:oracle_planner", settings=("candidates",), reads_truth=True,
+    PlannerEntry("oracle", "at least every other budget planner on the reported coverage (TSDF, of the true "
+                 "surface): the best, on that measure, of each one's views and of its own greedy pick over "
+                 "them, the start view and the views an ideal sensor sees most from (a 756-view lattice)",
+                 "nbv.planning.oracle:oracle_planner", settings=("candidates", "bov", "occupancy", "recon",
+                                                                 "metrics"), reads_truth=True,
                  prefixes=False),
 )
 """The shipped planners, in the order every generated list gives them."""

@@ -6,9 +6,9 @@ by a view when it projects inside the image in front of the camera and no surfac
 lies before it on its pixel's ray (its z-depth is within `tolerance_m` of the
 ray-cast depth there). Used to score planners cheaply where the TSDF pipeline
 would cost minutes (choosing `nbv train`'s defaults on validation buildings,
-`scripts/select_defaults.py`), and the objective of the coverage oracle planner
-(`nbv.planning.oracle`); reported figures use the fused reconstruction
-(`nbv.recon.evaluate`).
+`scripts/select_defaults.py`), and the search that proposes candidates to the
+coverage oracle planner (`nbv.planning.oracle`, which scores by fusion);
+reported figures use the fused reconstruction (`nbv.recon.evaluate`).
 
 Example: a unit cube seen from +x shows one face of six.
     >>> import trimesh

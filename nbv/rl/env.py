@@ -202,7 +202,7 @@ class NBVEnv(EnvBase):
         frame, descriptors = self.capture(self._view)
         self.bov.update(descriptors, self._view.azimuth, self._view.elevation)
         if self.reward_terms.coverage:
-            self._seen = self.surface_seen(self._view)
+            self._seen = self.surface_seen(self._view).copy()  # ours to grow: the node's cache stays as is
         location = normalise_viewpoint(self._view, self.config)
         self._frames = np.repeat(frame[None], self.config.history, axis=0)
         self._locations = np.repeat(location[None], self.config.history, axis=0)
@@ -329,7 +329,8 @@ class NBVEnv(EnvBase):
         return self.source.capture(view)
 
     def surface_seen(self, view: Viewpoint) -> np.ndarray:
-        """Which of the current target's surface samples `view` sees (with a lattice: its node does)."""
+        """Which of the current target's surface samples `view` sees (with a lattice: its node does, a
+        read-only array cached per node)."""
         scene = self._scene.scene
         if scene not in self._visibility:
             self._visibility[scene] = scene_visibility(self.scene, self.config.camera), self.scene.center()
@@ -338,7 +339,9 @@ class NBVEnv(EnvBase):
             return visibility.seen(viewpoint_to_c2w(view, center))
         node, index = self._lattice(self._scene).snap(view)
         if (scene, index) not in self._node_seen:
-            self._node_seen[scene, index] = visibility.seen(viewpoint_to_c2w(node, center))
+            seen = visibility.seen(viewpoint_to_c2w(node, center))
+            seen.setflags(write=False)  # shared by every episode that visits the node: never grown in place
+            self._node_seen[scene, index] = seen
         return self._node_seen[scene, index]
 
     def _lattice(self, spec: SceneSpec) -> ViewLattice:

@@ -13,7 +13,7 @@ from torchrl.collectors import Collector
 from torchrl.collectors.distributed import RayCollector
 from torchrl.data import ListStorage, TensorDictReplayBuffer
 from torchrl.data.replay_buffers import RandomSampler
-from torchrl.envs import EnvBase, ParallelEnv, RewardSum, TransformedEnv
+from torchrl.envs import EnvBase, ParallelEnv, TransformedEnv
 from torchrl.modules import ProbabilisticActor, ValueOperator
 from torchrl.objectives import SACLoss, SoftUpdate
 
@@ -28,6 +28,7 @@ from nbv.rl.config import (
     RewardConfig,
 )
 from nbv.rl.env import NBVEnv
+from nbv.rl.episode_return import EpisodeReturn
 
 RAY_COLLECTOR_CPUS = 1
 """CPUs a Ray collector actor asks for, and the threads its Dr.Jit and torch get."""
@@ -37,8 +38,9 @@ RAY_COLLECTOR_MEMORY = 1024**3
 
 def make_environment(config: EnvConfig, envs: int, seed: int,
                      reward_terms: RewardConfig = RewardConfig()) -> EnvBase:
-    """The training env: an in-process `NBVEnv` or a `ParallelEnv` of spawned workers, returns summed,
-    with the training-only `reward_terms` (`TrainConfig.reward`; none by default).
+    """The training env: an in-process `NBVEnv` or a `ParallelEnv` of spawned workers, returns summed
+    (`EpisodeReturn`: a restored episode keeps its return), with the training-only `reward_terms`
+    (`TrainConfig.reward`; none by default).
 
     Worker i is seeded `seed + i` and starts its scene cycle at scene i. The scenes are
     loaded once here first, so a bad scene name fails in this process with a clear message
@@ -51,7 +53,7 @@ def make_environment(config: EnvConfig, envs: int, seed: int,
     else:
         base = ParallelEnv(envs, [partial(NBVEnv, config, i, seed + i, reward_terms) for i in range(envs)],
                            mp_start_method="spawn", serial_for_single=True)
-    return TransformedEnv(base, RewardSum())
+    return TransformedEnv(base, EpisodeReturn())
 
 
 def make_sac_agent(env: EnvConfig, network: NetworkConfig) -> tuple[ProbabilisticActor, ValueOperator]:
@@ -106,7 +108,7 @@ def make_worker_env(config: EnvConfig, index: int, seed: int,
     """A Ray collector's env, built inside its actor: Dr.Jit and torch capped to the actor's one core
     (`nbv.fanout.worker`), the Mitsuba variant chosen there, returns summed as `make_environment`'s."""
     cap_threads(RAY_COLLECTOR_CPUS)
-    return TransformedEnv(NBVEnv(config, index, seed, reward_terms), RewardSum())
+    return TransformedEnv(NBVEnv(config, index, seed, reward_terms), EpisodeReturn())
 
 
 def make_ray_collector(env: EnvConfig, actor: ProbabilisticActor, config: CollectorConfig, seed: int,

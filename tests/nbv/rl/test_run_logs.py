@@ -1,12 +1,11 @@
-"""A run's logs cut back to its checkpoint on resume: rows after it, torn rows, lost headers, repeats."""
+"""A run's logs cut back to its checkpoint on resume: rows after it, torn rows, lost headers, repeats (a
+real 0-byte log left by a SIGKILL: test_kill_resume)."""
 
 from __future__ import annotations
 
 import csv
 
 from nbv.rl.run_logs import trim_log, validation_fields
-from nbv.rl.train import CSV_FIELDS, train_run
-from tests.nbv.rl.test_train import tiny
 
 FIELDS = ("frames", "a", "b")
 
@@ -47,12 +46,3 @@ def test_rows_logged_twice_by_an_earlier_resume_are_kept_once(tmp_path):
     path.write_text("\n".join(",".join(r) for r in [header, *rows]) + "\n")
     trim_log(path, 8, header)
     assert read(path) == (header, [[str(f), "50.0", "50.0", "2"] for f in (2, 4, 6, 8)])
-
-
-def test_a_zero_byte_metrics_csv_left_by_a_kill_is_repaired_not_fatal(tmp_path):
-    run = tmp_path / "run"
-    run.mkdir()
-    (run / "metrics.csv").write_bytes(b"")
-    train_run(tiny(run, 2))
-    header, rows = read(run / "metrics.csv")
-    assert header == list(CSV_FIELDS) and [r[0] for r in rows] == ["2"]

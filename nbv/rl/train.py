@@ -15,7 +15,8 @@ buffer, counters, torch / NumPy / Python random states and, with one worker
 start-view RNG, Bag of Views, the episode's return so far). So a one-worker
 run stopped or killed and resumed ends with the same parameters, replay
 buffer and logs as one that ran through: on resume, `metrics.csv` and
-`validation.csv` are cut back to the checkpoint (`nbv.rl.run_logs`). With parallel workers the
+`validation.csv` are cut back to the checkpoint (`nbv.rl.run_logs`), and the
+env's process renders on one Dr.Jit thread (`nbv.rl.builders.RENDER_THREADS`). With parallel workers the
 workers' episodes in flight are lost at a restart: they start new episodes,
 seeded `seed + frames done`, and everything else resumes exactly.
 

@@ -1,20 +1,21 @@
 """SIGKILL `nbv train` at random moments, resume it, and compare with a run that went through (issue 28).
 
-A trial runs the command as a subprocess (its own process group, as a shell
-would start it), kills the group with SIGKILL once or twice at random moments
-of the run (uniform between the moment the uninterrupted run opened its log
-and the moment it ended: before and after the first checkpoint), runs the
-same command again to the end, and compares the run folder with the
-uninterrupted run's: every tensor and value of `checkpoint.pt` (weights,
-optimisers, replay buffer, counters, random states, the env's snapshot; the
-recorded `--out` aside), the actor and counters of `policy.pt`, `metrics.csv`
-without its timing columns, and `validation.csv`. The settings are tiny
-(`ARGS`: 64x48 renders at 1 spp, tiny networks, a 1x8x2 lattice for the
-default preset), so one trial takes a few process starts.
+A trial starts the command in a fresh process (its own process group, as a
+shell would start it; a forkserver child that skips the imports, or with
+`--exec` a `python -m nbv.cli train` process), kills the group with SIGKILL
+once or twice, each at a uniform random time into the run's training (0 to
+the uninterrupted run's training time after the process opened or cut back
+its log: before and after the first checkpoint), runs the same command again
+to the end, and compares the run folder with the uninterrupted run's: every
+tensor and value of `checkpoint.pt` (weights, optimisers, replay buffer,
+counters, random states, the env's snapshot; the recorded `--out` aside), the
+actor and counters of `policy.pt`, `metrics.csv` without its timing columns,
+and `validation.csv`. The settings are tiny (`ARGS`: 64x48 renders at 1 spp,
+tiny networks, a 1x8x2 lattice for the default preset).
 
-    python scripts/kill_resume.py --preset paper --trials 10 --out /tmp/kills
+    PYTHONPATH=. python scripts/kill_resume.py --preset paper --trials 10 --out /tmp/kills
 
-prints one line per trial and `passed N/T`; it exits 1 unless all passed.
+prints one line per trial and `passed N/T (K kills)`; it exits 1 unless all passed.
 `tests/nbv/rl/test_kill_resume.py` kills at fixed moments in `make test`.
 """
 
@@ -26,6 +27,7 @@ import json
 import multiprocessing
 import os
 import random
+import shutil
 import signal
 import subprocess
 import sys
@@ -107,13 +109,10 @@ def _train_child(preset: str, out: Path) -> None:
     sys.exit(main(["train", *ARGS[preset], "--out", str(out)]))
 
 
-def finish(preset: str, out: Path) -> float:
-    """Run `nbv train` for `preset` into `out` to the end; its wall time (RuntimeError if it failed)."""
-    start = time.perf_counter()
-    process = launch(preset, out)
-    if process.wait() != 0:
+def finish(preset: str, out: Path, start: Callable = launch) -> None:
+    """Run `nbv train` for `preset` into `out` to the end (`start`: `launch` or `forked`)."""
+    if start(preset, out).wait() != 0:
         raise RuntimeError(f"nbv train {preset} into {out} failed: see {out}.log")
-    return time.perf_counter() - start
 
 
 def kill_when(process: subprocess.Popen | Forked, moment: Callable[[], bool],
@@ -153,10 +152,19 @@ def at_second_log_flush(out: Path) -> Callable[[], bool]:
     return moment
 
 
-def after_seconds(seconds: float) -> Callable[[], bool]:
-    """The moment `seconds` have passed from now."""
-    end = time.monotonic() + seconds
-    return lambda: time.monotonic() >= end
+def into_the_run(out: Path, delay_s: float) -> Callable[[], bool]:
+    """The moment `delay_s` after the run started training: after it opened metrics.csv (a new run) or cut
+    it back to its checkpoint (a resumed one), i.e. past its start-up."""
+    since, opened = time.time(), []
+
+    def moment() -> bool:
+        if not opened:
+            log = out / "metrics.csv"
+            if log.exists() and log.stat().st_mtime >= since:
+                opened.append(time.monotonic())
+            return False
+        return time.monotonic() - opened[0] >= delay_s
+    return moment
 
 
 def differences(a: Path, b: Path) -> list[str]:
@@ -212,17 +220,23 @@ def stage(out: Path) -> str:
     return f"after the checkpoint at {frames} frames"
 
 
-def trial(preset: str, reference: Path, out: Path, log_start_s: float, total_s: float,
-          rng: random.Random) -> tuple[bool, str]:
-    """One trial: 1 or 2 kills at random moments, then the run to its end; (equal, description)."""
-    notes = []
-    for _ in range(rng.randint(1, 2)):
-        at = rng.uniform(log_start_s, total_s)
-        if kill_when(launch(preset, out), after_seconds(at)):
-            notes.append(f"killed at {at:.1f} s, {stage(out)}")
+def trial(preset: str, reference: Path, out: Path, train_s: float, rng: random.Random,
+          start: Callable = forked) -> tuple[bool, str]:
+    """One trial: 1 or 2 kills, each a uniform random time into the run (0 to `train_s`, the uninterrupted
+    run's training time), then the run to its end; (equal to `reference`, what happened). A run that ends
+    before its first kill starts again from scratch, so every trial kills at least once."""
+    notes, kills = [], rng.randint(1, 2)
+    while kills:
+        delay = rng.uniform(0.0, train_s)
+        if kill_when(start(preset, out), into_the_run(out, delay)):
+            notes.append(f"killed {delay:.1f} s in, {stage(out)}")
+            kills -= 1
+        elif len(notes) == 0 or notes[-1].startswith("ended"):
+            notes.append(f"ended before {delay:.1f} s in: again from scratch")
+            shutil.rmtree(out)
         else:
-            notes.append(f"ended before {at:.1f} s")
-    finish(preset, out)
+            break  # the resumed run finished before a second kill
+    finish(preset, out, start)
     diffs = differences(reference, out)
     return not diffs, "; ".join(notes) + (f" -> DIFFER: {', '.join(diffs[:6])}" if diffs else " -> equal")
 
@@ -233,28 +247,37 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--trials", type=int, default=10)
     parser.add_argument("--seed", type=int, default=0, help="seed of the kill moments")
     parser.add_argument("--out", type=Path, required=True, help="scratch folder (run folders and logs)")
+    parser.add_argument("--exec", action="store_true",
+                        help="start each run as `python -m nbv.cli train` (seconds of imports each), "
+                             "not as a forkserver child")
     args = parser.parse_args(argv)
+    start = launch if args.exec else forked
+    if not args.exec:
+        preload_forkserver()
     args.out.mkdir(parents=True, exist_ok=True)
     reference = args.out / f"{args.preset}-reference"
-    start = time.perf_counter()
-    process = launch(args.preset, reference)
+    began = time.perf_counter()
+    process = start(args.preset, reference)
     while process.poll() is None and not (reference / "metrics.csv").exists():
         time.sleep(POLL_S)
-    log_start_s = time.perf_counter() - start
+    opened = time.perf_counter()
     if process.wait() != 0:
         raise SystemExit(f"the uninterrupted run failed: see {reference}.log")
-    total_s = time.perf_counter() - start
-    print(f"{args.preset}: uninterrupted run {total_s:.1f} s, its log opened at {log_start_s:.1f} s",
+    train_s = time.perf_counter() - opened
+    print(f"{args.preset}: uninterrupted run {time.perf_counter() - began:.1f} s, training {train_s:.1f} s",
           flush=True)
-    rng, passed = random.Random(args.seed), 0
+    rng, passed, killed = random.Random(args.seed), 0, 0
     for k in range(args.trials):
-        out = args.out / f"{args.preset}-trial{k}"
-        ok, note = trial(args.preset, reference, out, log_start_s, total_s, rng)
+        ok, note = trial(args.preset, reference, args.out / f"{args.preset}-trial{k}", train_s, rng, start)
         passed += ok
+        killed += note.count("killed ")
         print(f"trial {k}: {note}", flush=True)
-    print(f"{args.preset}: passed {passed}/{args.trials}")
+    print(f"{args.preset}: passed {passed}/{args.trials} ({killed} kills)")
     return 0 if passed == args.trials else 1
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.path.insert(0, str(ROOT))  # so forkserver children import this file as scripts.kill_resume
+    from scripts.kill_resume import main as harness
+
+    sys.exit(harness())

@@ -134,8 +134,10 @@ def kill_when(process: subprocess.Popen | Forked, moment: Callable[[], bool],
 
 
 def before_first_checkpoint(out: Path) -> Callable[[], bool]:
-    """The moment the run has opened metrics.csv but written no checkpoint (its header still buffered)."""
-    return lambda: (out / "metrics.csv").exists() and not (out / "checkpoint.pt").exists()
+    """The moment the run has opened metrics.csv, still empty (its header buffered), and written no
+    checkpoint."""
+    log = out / "metrics.csv"
+    return lambda: log.exists() and log.stat().st_size == 0 and not (out / "checkpoint.pt").exists()
 
 
 def at_second_log_flush(out: Path) -> Callable[[], bool]:

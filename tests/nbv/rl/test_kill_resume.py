@@ -39,6 +39,7 @@ def test_killed_before_and_after_the_first_checkpoint_then_resumed_equals_uninte
     assert kill_when(forked(preset, killed), before_first_checkpoint(killed))
     assert (killed / "metrics.csv").stat().st_size == 0  # what broke every rerun (F9)
     assert kill_when(forked(preset, killed), at_second_log_flush(killed))
-    assert stage(killed) == "after the checkpoint at 12 frames"  # and the rows up to 24 on disk (F10)
+    # Rows up to 24 on disk, the checkpoint at 12 (F10); a poller descheduled past the next checkpoint: 24.
+    assert stage(killed) in ("after the checkpoint at 12 frames", "after the checkpoint at 24 frames")
     assert main(["train", *ARGS[preset], "--out", str(killed)]) == 0
     assert differences(straight, killed) == []

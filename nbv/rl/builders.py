@@ -13,7 +13,7 @@ from torchrl.collectors import Collector
 from torchrl.collectors.distributed import RayCollector
 from torchrl.data import ListStorage, TensorDictReplayBuffer
 from torchrl.data.replay_buffers import RandomSampler
-from torchrl.envs import EnvBase, ParallelEnv, RewardSum, TransformedEnv
+from torchrl.envs import EnvBase, ParallelEnv, TransformedEnv
 from torchrl.modules import ProbabilisticActor, ValueOperator
 from torchrl.objectives import SACLoss, SoftUpdate
 
@@ -28,7 +28,17 @@ from nbv.rl.config import (
     RewardConfig,
 )
 from nbv.rl.env import NBVEnv
+from nbv.rl.episode_return import EpisodeReturn
+from render.variant import configure_libllvm
 
+RENDER_THREADS = 1
+"""Dr.Jit threads of a process that steps a training env. The RGB pass's pixel filter adds each sample into
+several pixels with atomic adds, whose order across threads varies, and with it the last bit of the sums:
+on 2 threads 8 of 200 renders of the same 32x24 views differed from the first pass (by 1 ulp in about 90
+pixels), now and then one grey level of a frame, after which a run drifts from its resumption (issue 28,
+F11). On one thread every render of a view is the same. On the shared 2 cores at a load of 10-12, one
+thread rendered as fast as two (160x120 4 spp: 104-147 against 125-128 ms; 320x240 16 spp: 0.86-1.0
+against 0.89-1.2 s); on idle cores two are up to twice as fast."""
 RAY_COLLECTOR_CPUS = 1
 """CPUs a Ray collector actor asks for, and the threads its Dr.Jit and torch get."""
 RAY_COLLECTOR_MEMORY = 1024**3
@@ -37,21 +47,32 @@ RAY_COLLECTOR_MEMORY = 1024**3
 
 def make_environment(config: EnvConfig, envs: int, seed: int,
                      reward_terms: RewardConfig = RewardConfig()) -> EnvBase:
-    """The training env: an in-process `NBVEnv` or a `ParallelEnv` of spawned workers, returns summed,
-    with the training-only `reward_terms` (`TrainConfig.reward`; none by default).
+    """The training env: an in-process `NBVEnv` or a `ParallelEnv` of spawned workers, returns summed
+    (`EpisodeReturn`: a restored episode keeps its return), with the training-only `reward_terms`
+    (`TrainConfig.reward`; none by default).
 
-    Worker i is seeded `seed + i` and starts its scene cycle at scene i. The scenes are
-    loaded once here first, so a bad scene name fails in this process with a clear message
-    rather than inside a worker.
+    Worker i is seeded `seed + i` and starts its scene cycle at scene i; the process stepping an env
+    renders on one Dr.Jit thread (`training_env`). The scenes are loaded once here first, so a bad scene
+    name fails in this process with a clear message rather than inside a worker.
     """
     for spec in config.scenes.specs():
         spec.load()
     if envs == 1:
-        base: EnvBase = NBVEnv(config, 0, seed, reward_terms)
+        base: EnvBase = training_env(config, 0, seed, reward_terms)
     else:
-        base = ParallelEnv(envs, [partial(NBVEnv, config, i, seed + i, reward_terms) for i in range(envs)],
-                           mp_start_method="spawn", serial_for_single=True)
-    return TransformedEnv(base, RewardSum())
+        makers = [partial(training_env, config, i, seed + i, reward_terms) for i in range(envs)]
+        base = ParallelEnv(envs, makers, mp_start_method="spawn", serial_for_single=True)
+    return TransformedEnv(base, EpisodeReturn())
+
+
+def training_env(config: EnvConfig, index: int, seed: int, reward_terms: RewardConfig) -> NBVEnv:
+    """Env `index` of a training run, in the process that steps it, which renders on `RENDER_THREADS`
+    Dr.Jit threads from now on (reproducible renders)."""
+    configure_libllvm()  # before Dr.Jit's first import
+    import drjit as dr
+
+    dr.set_thread_count(RENDER_THREADS)
+    return NBVEnv(config, index, seed, reward_terms)
 
 
 def make_sac_agent(env: EnvConfig, network: NetworkConfig) -> tuple[ProbabilisticActor, ValueOperator]:
@@ -106,7 +127,7 @@ def make_worker_env(config: EnvConfig, index: int, seed: int,
     """A Ray collector's env, built inside its actor: Dr.Jit and torch capped to the actor's one core
     (`nbv.fanout.worker`), the Mitsuba variant chosen there, returns summed as `make_environment`'s."""
     cap_threads(RAY_COLLECTOR_CPUS)
-    return TransformedEnv(NBVEnv(config, index, seed, reward_terms), RewardSum())
+    return TransformedEnv(NBVEnv(config, index, seed, reward_terms), EpisodeReturn())
 
 
 def make_ray_collector(env: EnvConfig, actor: ProbabilisticActor, config: CollectorConfig, seed: int,

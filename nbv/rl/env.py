@@ -72,6 +72,7 @@ from nbv.features.sift import FeatureConfig
 from nbv.features.source import ViewSource
 from nbv.recon.visibility import SurfaceVisibility, scene_visibility
 from nbv.rl.config import EnvConfig, RewardConfig
+from nbv.rl.episode_return import RETURN_KEY
 from nbv.rl.lattice import ViewLattice, build_lattice
 from render.viewpoint import TWO_PI, Viewpoint, draw_viewpoint, viewpoint_to_c2w
 from scenes.model import Scene
@@ -177,6 +178,7 @@ class NBVEnv(EnvBase):
         self._bov: BagOfViews | None = None
         self._resume_pending = False
         self._view: Viewpoint | None = None
+        self._return = torch.zeros(1)  # the episode's return so far (float32, summed as `RewardSum` does)
         self._set_seed(seed)
 
     # -- TorchRL hooks -------------------------------------------------------------------------
@@ -192,7 +194,7 @@ class NBVEnv(EnvBase):
         if self._resume_pending:
             # A restored snapshot continues its episode: the collector's first reset resumes it.
             self._resume_pending = False
-            return self._observation()
+            return self._observation().set(RETURN_KEY, self._return.clone())  # `EpisodeReturn` keeps it
         self._scene = self._scenes[(self.worker + self._episode) % len(self._scenes)]
         self.source.select(self._scene)
         self._episode += 1
@@ -202,12 +204,13 @@ class NBVEnv(EnvBase):
         frame, descriptors = self.capture(self._view)
         self.bov.update(descriptors, self._view.azimuth, self._view.elevation)
         if self.reward_terms.coverage:
-            self._seen = self.surface_seen(self._view)
+            self._seen = self.surface_seen(self._view).copy()  # ours to grow: the node's cache stays as is
         location = normalise_viewpoint(self._view, self.config)
         self._frames = np.repeat(frame[None], self.config.history, axis=0)
         self._locations = np.repeat(location[None], self.config.history, axis=0)
         self._progress = 0.0
         self._steps = 0
+        self._return = torch.zeros(1)
         return self._observation()
 
     def _step(self, tensordict: TensorDictBase) -> TensorDictBase:
@@ -230,6 +233,7 @@ class NBVEnv(EnvBase):
         truncated = not terminated and self._steps >= self.config.max_steps
         out = self._observation(terminated, truncated)
         out.set("reward", torch.tensor([reward], dtype=torch.float32))
+        self._return = self._return + out["reward"]  # as `RewardSum` sums it: a resume continues it exactly
         return out
 
     # -- state ---------------------------------------------------------------------------------
@@ -280,7 +284,8 @@ class NBVEnv(EnvBase):
         return self._view
 
     def snapshot(self) -> dict[str, Any]:
-        """The env's full runtime state (episode, histories, RNG, BoV), loadable with weights_only."""
+        """The env's full runtime state (episode, its return so far, histories, RNG, BoV), loadable with
+        weights_only."""
         if self._view is None:
             raise RuntimeError("NBVEnv.snapshot needs an episode: call reset() first")
         return {
@@ -289,6 +294,7 @@ class NBVEnv(EnvBase):
             "view": self._view.as_array().tolist(), "frames": torch.from_numpy(self._frames.copy()),
             "locations": torch.from_numpy(self._locations.copy()),
             "progress": self._progress, "steps": self._steps, "bov": self.bov.state_dict(),
+            "episode_return": self._return.clone(),
             **({"seen": torch.from_numpy(self._seen.copy())} if self._seen is not None else {}),
         }
 
@@ -302,6 +308,7 @@ class NBVEnv(EnvBase):
         self._view = Viewpoint(*map(float, state["view"]))
         self._frames, self._locations = state["frames"].numpy().copy(), state["locations"].numpy().copy()
         self._progress, self._steps = float(state["progress"]), int(state["steps"])
+        self._return = state.get("episode_return", torch.zeros(1)).clone()  # older snapshots: restarts at 0
         self.bov.load_state_dict(state["bov"])
         self._seen = state["seen"].numpy().copy() if "seen" in state else None
         self._resume_pending = True
@@ -329,7 +336,8 @@ class NBVEnv(EnvBase):
         return self.source.capture(view)
 
     def surface_seen(self, view: Viewpoint) -> np.ndarray:
-        """Which of the current target's surface samples `view` sees (with a lattice: its node does)."""
+        """Which of the current target's surface samples `view` sees (with a lattice: its node does, a
+        read-only array cached per node)."""
         scene = self._scene.scene
         if scene not in self._visibility:
             self._visibility[scene] = scene_visibility(self.scene, self.config.camera), self.scene.center()
@@ -338,7 +346,9 @@ class NBVEnv(EnvBase):
             return visibility.seen(viewpoint_to_c2w(view, center))
         node, index = self._lattice(self._scene).snap(view)
         if (scene, index) not in self._node_seen:
-            self._node_seen[scene, index] = visibility.seen(viewpoint_to_c2w(node, center))
+            seen = visibility.seen(viewpoint_to_c2w(node, center))
+            seen.setflags(write=False)  # shared by every episode that visits the node: never grown in place
+            self._node_seen[scene, index] = seen
         return self._node_seen[scene, index]
 
     def _lattice(self, spec: SceneSpec) -> ViewLattice:

@@ -12,8 +12,11 @@ Exact resumption: checkpoints are taken between iterations and hold
 everything the rest of the run depends on: networks, optimisers, replay
 buffer, counters, torch / NumPy / Python random states and, with one worker
 (in-process), the env's own state (episode in progress, render seed counter,
-start-view RNG, Bag of Views). So a one-worker run stopped and resumed ends
-with the same parameters as one that ran through. With parallel workers the
+start-view RNG, Bag of Views, the episode's return so far). So a one-worker
+run stopped or killed and resumed ends with the same parameters, replay
+buffer and logs as one that ran through: on resume, `metrics.csv` and
+`validation.csv` are cut back to the checkpoint (`nbv.rl.run_logs`), and the
+env's process renders on one Dr.Jit thread (`nbv.rl.builders.RENDER_THREADS`). With parallel workers the
 workers' episodes in flight are lost at a restart: they start new episodes,
 seeded `seed + frames done`, and everything else resumes exactly.
 
@@ -65,6 +68,7 @@ from nbv.rl.checkpoint import (
 )
 from nbv.rl.config import OptimConfig, TrainConfig, upgrade_record
 from nbv.rl.env import NBVEnv
+from nbv.rl.run_logs import trim_log, validation_fields
 from nbv.rl.validate import LatticeValidator
 from nbv.viz.figures import plot_training_curves
 
@@ -117,6 +121,8 @@ def train_run(config: TrainConfig) -> Path:
     actor, critic = make_sac_agent(config.env, config.network)
     learner = make_learner(actor, critic, config)
     frames, updates = learner.restore(resumed) if resumed is not None else (0, 0)
+    trim_log(run / METRICS_CSV, frames, CSV_FIELDS)  # the logs end where the checkpoint does
+    trim_log(run / VALIDATION_CSV, frames, validation_fields(config.validation.validation_scenes))
     if frames >= config.collector.frames:
         return run / CHECKPOINT  # the budget is already spent: nothing to do
     validator = None
@@ -222,13 +228,14 @@ def make_run_collector(config: TrainConfig, actor: ProbabilisticActor, frames: i
 
 
 class RunLog:
-    """A run's training logs: `metrics.csv` (appended to when resuming), TensorBoard scalars under
+    """A run's training logs: `metrics.csv` (appended to when resuming, after `trim_log` cut it back to the
+    checkpoint), TensorBoard scalars under
     `tensorboard/`, the progress bar, and the learning curves `training.png` at each checkpoint."""
 
     def __init__(self, run: Path, config: TrainConfig, frames: int) -> None:
         self.run, self.csv_path = run, run / METRICS_CSV
         self._writer = SummaryWriter(str(run / "tensorboard"))
-        new_csv = not self.csv_path.exists()
+        new_csv = not self.csv_path.is_file() or self.csv_path.stat().st_size == 0
         self._file = open(self.csv_path, "a", newline="")
         self._csv = csv.DictWriter(self._file, CSV_FIELDS)
         if new_csv:
@@ -310,11 +317,11 @@ def validate_checkpoint(validator: LatticeValidator, run: Path, config: TrainCon
         save_policy(run / POLICY, json.dumps(config_record(config)), loss_state, counters)
         best = {"frames": counters["frames"], "score": score}
     path = run / VALIDATION_CSV
-    new = not path.exists()
+    new = not path.is_file() or path.stat().st_size == 0
     with open(path, "a", newline="") as file:
         log = csv.writer(file)
         if new:
-            log.writerow(["frames", *scores, "mean", "best_frames"])
+            log.writerow(validation_fields(list(scores)))
         log.writerow([counters["frames"], *(f"{v:.3f}" for v in scores.values()), f"{score:.3f}",
                       best["frames"]])
     return best

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import fields, replace
 
+import numpy as np
 import pytest
 import torch
 from tensordict import TensorDict
@@ -23,7 +24,7 @@ from nbv.rl.env import NBVEnv
 from nbv.rl.validate import LatticeValidator, evaluation_env_config, validation_env_config
 from render.camera import UAVCamera
 from render.settings import RenderSettings
-from render.viewpoint import viewpoint_to_c2w
+from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes import load_scene
 from scenes.spec import SceneSet
 
@@ -83,6 +84,31 @@ def test_on_a_lattice_the_term_counts_what_the_nodes_see(tmp_path, monkeypatch):
     nodes = [lattice.snap(view)[0] for view in views]
     expected = [r + 20.0 * s for r, s in zip(bov_only, new_shares(nodes))]
     assert weighted == pytest.approx(expected, abs=1e-4)
+
+
+def test_a_lattice_nodes_reward_is_the_same_in_the_first_and_the_hundredth_episode(tmp_path, monkeypatch):
+    monkeypatch.setenv("NBV_CACHE_DIR", str(tmp_path))
+    grid = LatticeConfig(enabled=True, lattice_radii=1, lattice_azimuths=4, lattice_elevations=2)
+    terms = RewardConfig(coverage=20.0)
+    env = NBVEnv(config(lattice=grid), seed=3, reward_terms=terms)
+    for _ in range(99):
+        fly(env)
+    start = env._rng.bit_generator.state  # the hundredth episode's start view is drawn from here
+    hundredth, views = fly(env)
+    first = NBVEnv(config(lattice=grid), seed=3, reward_terms=terms)
+    first._rng.bit_generator.state = start
+    rewards, same_views = fly(first)  # the same start node and actions, in a fresh env's first episode
+    assert [v.as_array().tolist() for v in same_views] == [v.as_array().tolist() for v in views]
+    assert hundredth == rewards
+    assert len({env._lattice(env._scene).snap(v)[1] for v in views}) > 1  # it moved between nodes
+    scene = load_scene("test_building")
+    visibility = scene_visibility(scene, UAVCamera(64, 48))
+    lattice = env._lattice(env._scene)
+    assert len(env._node_seen) == 8  # 100 episodes visited every node: none of their caches grew
+    for (_, index), cached in env._node_seen.items():
+        i, j, k = np.unravel_index(index, [len(axis) for axis in lattice.axes])
+        node = Viewpoint(*(float(axis[n]) for axis, n in zip(lattice.axes, (i, j, k))))
+        assert np.array_equal(cached, visibility.seen(viewpoint_to_c2w(node, scene.center()))), index
 
 
 @pytest.fixture

@@ -61,6 +61,36 @@ def test_one_worker_interrupted_and_resumed_equals_uninterrupted(tmp_path):
     for key in a["loss"]:
         assert torch.equal(a["loss"][key], b["loss"][key]), key
     assert torch.equal(a["rng"]["torch"], b["rng"]["torch"])
+    assert_same(a["buffer"], b["buffer"])  # the resumed episode's return (episode_reward) included
+    assert logged(tmp_path / "straight") == logged(tmp_path / "resumed")
+    assert [row["episode_return"] for row in logged(tmp_path / "resumed")][1:3] != ["", ""]
+
+
+def assert_same(a, b, where: str = "") -> None:
+    """Nested dicts, lists and tensors `a` and `b` are equal, bit for bit (NaN equal to NaN)."""
+    assert type(a) is type(b), where
+    if isinstance(a, dict):
+        assert a.keys() == b.keys(), where
+        for key in a:
+            assert_same(a[key], b[key], f"{where}.{key}")
+    elif isinstance(a, list | tuple):
+        assert len(a) == len(b), where
+        for i, (x, y) in enumerate(zip(a, b)):
+            assert_same(x, y, f"{where}[{i}]")
+    elif isinstance(a, torch.Tensor):
+        assert torch.equal(a, b) or torch.allclose(a, b, rtol=0, atol=0, equal_nan=True), where
+    else:
+        assert a == b, where
+
+
+TIMING = ("collect_s", "update_s")
+"""Wall-clock columns of metrics.csv: the only ones a resumed run may log differently."""
+
+
+def logged(run) -> list[dict]:
+    """A run's metrics.csv rows without the timing columns (read with the csv module)."""
+    with open(run / "metrics.csv", newline="") as file:
+        return [{k: v for k, v in row.items() if k not in TIMING} for row in csv.DictReader(file)]
 
 
 def test_two_worker_cli_run_writes_checkpoint_and_resumes(tmp_path):

@@ -1,7 +1,8 @@
 """`nbv sfm` end to end on a case whose answer is known: an arc of six views of a textured box (ray-cast
 in NumPy, exact poses) registers whole, its camera centres within millimetres of the truth after the
 similarity fit, with the intrinsics held at the dataset's; GNSS priors put the model in the world
-frame; featureless views give no model, said so; bad inputs are named errors."""
+frame (through `nbv plan --sfm`'s summary); featureless views give no model, said so; bad inputs are
+named errors."""
 
 from __future__ import annotations
 
@@ -13,11 +14,15 @@ import pytest
 from synthetic import write_circle_dataset
 from synthetic_box import write_box_arc
 
-from common.provenance import recorded_config
+from common.io import atomic_folder
+from common.provenance import recorded_config, run_record
 from nbv.cli import main
-from nbv.sfm.config import SfmConfig
+from nbv.planning.config import PlanConfig
+from nbv.sfm.check import sfm_summary
+from nbv.sfm.config import SfmConfig, SfmSettings
 from nbv.sfm.pipeline import pinhole_params
 from render.dataset import read_dataset
+from scenes.spec import SceneSpec
 
 ARC = {"views": 6, "step_deg": 15.0, "size": (240, 180)}
 """The smallest arc measured to register reliably: at 160 x 120 the same arc folds."""
@@ -60,16 +65,6 @@ def test_the_model_reads_back_with_the_dataset_intrinsics_held(result, arc):
     assert not (out / "sparse" / "1").exists() and not list(out.glob("*.db"))
     assert report["command"] == "nbv sfm" and report["pycolmap"] == "4.2.1"
     assert recorded_config(SfmConfig, out / "sfm.json", "nbv sfm").dataset == arc
-
-
-def test_gnss_priors_put_the_model_in_the_world_frame(arc, tmp_path):
-    out = tmp_path / "gnss"
-    args = ["sfm", str(arc), "--out", str(out), "--gnss-noise-m", "0.01", "--matching", "spatial"]
-    assert main(args) == 0
-    report = json.loads((out / "sfm.json").read_text())
-    assert report["registered"] == 6 and report["config"]["sfm"]["gnss_noise_m"] == 0.01
-    assert report["pose_error"]["scale"] == pytest.approx(1.0, abs=0.03)
-    assert report["centre_error_world_cm"]["max"] < 3.0
 
 
 def test_featureless_views_give_no_model_and_say_so(tmp_path, capsys):
@@ -117,3 +112,23 @@ def test_an_output_inside_the_dataset_is_refused(tmp_path, capsys):
     data = write_circle_dataset(tmp_path / "data", [1, 2, 3])
     assert main(["sfm", str(data), "--out", str(data / "sfm")]) == 2
     assert "must not be the input folder" in capsys.readouterr().err
+
+
+def test_a_plan_with_sfm_and_gnss_priors_keeps_the_world_frame_headline(arc, tmp_path):
+    """Position priors put the model in the world frame (scale 1, centres near the truth without a fit);
+    the relative image links of a plan's out/sfm survive the output folder's swap into place."""
+    gnss = SfmSettings(gnss_noise_m=0.01, matching="spatial")
+    config = PlanConfig(scene=SceneSpec(scene="test_building"), out=tmp_path / "plan", sfm=True,
+                        sfm_settings=gnss)
+    with atomic_folder(config.out) as folder:  # as `nbv plan --sfm` does, inside its output folder
+        shutil.copytree(arc, folder / "views")
+        summary = sfm_summary(read_dataset(folder / "views"), config.sfm_settings, config.seed,
+                              folder / "sfm", run_record("nbv plan", config))
+    assert (summary["views"], summary["registered"], summary["models"]) == (6, 6, 1)
+    assert summary["pose_error"]["scale"] == pytest.approx(1.0, abs=0.03)
+    assert summary["centre_error_world_cm"]["max"] < 3.0
+    assert "model_summaries" not in summary
+    links = sorted((config.out / "sfm" / "images").iterdir())
+    assert len(links) == 6 and all(link.resolve().is_file() for link in links)
+    doc = json.loads((config.out / "sfm" / "sfm.json").read_text())
+    assert doc["command"] == "nbv plan" and doc["config"]["sfm_settings"]["gnss_noise_m"] == 0.01

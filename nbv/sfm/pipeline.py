@@ -109,8 +109,7 @@ def run_sfm(images: Path, names: list[str], camera: UAVCamera, centres: np.ndarr
     """COLMAP on the images `names` under `images` (true centres `centres`, (N, 3), for priors and
     spatial pairs); the database and COLMAP's own output go under `work`."""
     threads = colmap_threads(settings.colmap_threads)
-    if not settings.colmap_log:
-        pycolmap.logging.minloglevel = QUIET_LOG_LEVEL
+    pycolmap.logging.minloglevel = 0 if settings.colmap_log else QUIET_LOG_LEVEL
     pycolmap.set_random_seed(seed)
     database, seconds = work / "database.db", {}
     start = time.perf_counter()
@@ -119,6 +118,7 @@ def run_sfm(images: Path, names: list[str], camera: UAVCamera, centres: np.ndarr
     priors: dict[str, np.ndarray] = {}
     if settings.gnss_noise_m is not None or settings.matching == "spatial":
         priors = gnss_positions(names, centres, settings.gnss_noise_m or 0.0, seed)
+        # without GNSS the exact centres only choose spatial pairs: mapping ignores priors (and their 1 m)
         write_priors(database, priors, settings.gnss_noise_m or 1.0)
     start = time.perf_counter()
     match(database, settings, threads)

@@ -17,6 +17,7 @@ from synthetic_box import write_box_arc
 from common.io import atomic_folder
 from common.provenance import recorded_config, run_record
 from nbv.cli import main
+from nbv.cli.sfm import summary_line
 from nbv.planning.config import PlanConfig
 from nbv.sfm.check import sfm_summary
 from nbv.sfm.config import SfmConfig, SfmSettings
@@ -40,7 +41,7 @@ def result(arc, tmp_path_factory):
     return out, json.loads((out / "sfm.json").read_text())
 
 
-def test_the_arc_registers_whole_with_centres_within_millimetres(result, capsys):
+def test_the_arc_registers_whole_with_centres_within_millimetres(result):
     _, report = result
     assert (report["views"], report["registered"], report["models"]) == (6, 6, 1)
     assert report["points"] > 100 and report["reprojection_error_px"] < 0.5
@@ -49,6 +50,9 @@ def test_the_arc_registers_whole_with_centres_within_millimetres(result, capsys)
     assert error["centre_error_cm"]["max"] < 0.5 and error["centre_error_pct_radius"]["max"] < 0.25
     assert error["rotation_error_deg"]["max"] < 1.0
     assert error["relative_rotation_error_deg"]["max"] < 0.5
+    line = summary_line(report)
+    assert line.startswith("6 of 6 views registered in the largest of 1 model(s)")
+    assert f"mean {error['centre_error_cm']['mean']:.2f} cm" in line
 
 
 def test_the_model_reads_back_with_the_dataset_intrinsics_held(result, arc):

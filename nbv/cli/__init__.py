@@ -33,6 +33,7 @@ COMMANDS = {
     "refine": Command("refine", "keep the views a Bag of Views finds new (paper Alg. 1)"),
     "refine-sweep": Command("refine_sweep", "kept-view counts over a grid of N and W (paper Table 2)"),
     "export": Command("export", "export a view dataset as a COLMAP model (cameras, images, points3D)"),
+    "sfm": Command("sfm", "COLMAP structure from motion on a view dataset, scored against its poses"),
     "reconstruct": Command("reconstruct", "TSDF-fuse a view dataset into a mesh and a point cloud"),
     "evaluate": Command("evaluate", "Chamfer, Hausdorff, coverage and F-score, with a heat map"),
     "train": Command("train", "train the SAC next-best-view policy (resumes a run folder)"),

@@ -15,5 +15,6 @@ def main(args: Sequence[str], prog: str) -> int:
     """Parse `PlanConfig`; plan, capture, reconstruct and score; print the metrics (no `reference` with
     --no-full-scan)."""
     doc = plan_scan(parse(PlanConfig, args, prog))
-    print(json.dumps({k: doc[k] for k in ("planner", "views", "gt", "reference") if k in doc}, indent=2))
+    keys = ("planner", "views", "gt", "reference", "sfm")
+    print(json.dumps({k: doc[k] for k in keys if k in doc}, indent=2))
     return 0

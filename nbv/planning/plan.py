@@ -151,6 +151,11 @@ def plan_scan(config: PlanConfig) -> dict:
                "viewpoints": [v.as_array().tolist() for v in views], **flight,
                **run_record("nbv plan", config),
                **{name: result.as_dict() for name, result in results.items()}}
+        if config.sfm:
+            from nbv.sfm.check import sfm_summary  # pycolmap only when asked for
+
+            doc["sfm"] = sfm_summary(read_dataset(dataset), config.sfm_settings, config.seed, folder / "sfm",
+                                     run_record("nbv plan", config))
         write_json(folder / "plan.json", doc)
         poses = np.stack([viewpoint_to_c2w(v, scene.center()) for v in views])
         flown = shell_path(start_view(env_config, config.seed), views).points + scene.center()

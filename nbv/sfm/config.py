@@ -1,0 +1,60 @@
+"""Settings of the structure-from-motion check (`nbv sfm`): COLMAP's pipeline through pycolmap."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated, Literal
+
+from tyro.conf import Positional, arg
+
+
+@dataclass(frozen=True)
+class SfmSettings:
+    """How COLMAP reconstructs a view set: features, matching, incremental mapping with fixed intrinsics."""
+
+    matching: Literal["exhaustive", "spatial"] = "exhaustive"
+    """Image pairs matched: every pair, or each view with its nearest views by position (the dataset's
+    poses, or the GNSS positions with --gnss-noise-m: for large sets)."""
+    spatial_neighbours: int = 20
+    """Nearest views by position each view is matched with under --matching spatial."""
+    sift_max_features: int = 8192
+    """Most SIFT features COLMAP extracts per image (COLMAP's default 8192)."""
+    gnss_noise_m: float | None = None
+    """Position priors as a UAV's GNSS gives them: each true camera centre plus seeded Gaussian noise of
+    this standard deviation per axis, metres, used in COLMAP's bundle adjustment (the model comes out in
+    the world frame); None: no priors."""
+    colmap_threads: int = 0
+    """Threads of COLMAP's extraction, matching and mapping; 0: the cores this process may use."""
+    colmap_log: bool = False
+    """Print COLMAP's own log to stderr (off: only fatal errors)."""
+
+    def __post_init__(self) -> None:
+        if self.spatial_neighbours < 1:
+            raise ValueError(f"spatial_neighbours must be >= 1, got {self.spatial_neighbours}")
+        if self.sift_max_features < 1:
+            raise ValueError(f"sift_max_features must be >= 1, got {self.sift_max_features}")
+        noise = self.gnss_noise_m
+        if noise is not None and not (math.isfinite(noise) and noise > 0):
+            raise ValueError(f"gnss_noise_m must be a positive number of metres (omit it for no priors), "
+                             f"got {noise}")
+        if self.colmap_threads < 0:
+            raise ValueError(f"colmap_threads must be >= 0 (0: the usable cores), got {self.colmap_threads}")
+
+
+@dataclass(frozen=True, kw_only=True)
+class SfmConfig:
+    """Settings of `nbv sfm`: COLMAP's structure from motion on a view dataset, scored against its poses."""
+
+    dataset: Annotated[Path, Positional, arg(metavar="DATASET")]
+    """A view dataset folder (transforms.json, images/), e.g. from `nbv scan`."""
+    out: Path
+    """Output folder, written atomically: images/ (links), sparse/0/ (the largest model; others
+    sparse/1, ...) and sfm.json."""
+    sfm: SfmSettings = SfmSettings()
+    """How COLMAP reconstructs."""
+    seed: int = 0
+    """Seed of COLMAP's random sampling and of the GNSS noise."""
+    overwrite: bool = False
+    """Replace an existing non-empty output folder (only once the new result is complete)."""

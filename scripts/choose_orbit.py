@@ -5,9 +5,10 @@ views on every training building (`nbv.rl.presets.TRAIN_SCENES`; a test building
 imperial_temple or random:SEED with SEED % 5 == 0, is refused), each run an `nbv plan` run of a
 `PlannerStudy` scored by the project's measure: the TSDF reconstruction's coverage of the true surface.
 The ring of the best mean is `orbit`. Then every two-ring pattern whose first ring is one of the
-`--first` best single rings and whose second is a ring of the grid's radii at a `--second-elevations`
-elevation above the first's is flown as
-`orbit2:R1,E1,R2,E2`; the best mean is `orbit2`. The choice, the command, the commit, the resolution and
+`--first` best single rings or a ring of the `--pair-radii` (default: the grid's) at a
+`--first-elevations` elevation, and whose second is a ring of the `--pair-radii` at a
+`--second-elevations` elevation above the first's, is flown as `orbit2:R1,E1,R2,E2`; the best mean
+is `orbit2`. The choice, the command, the commit, the resolution and
 every score go to `--out` (the shipped `nbv/planning/shipped/orbit.json`, read by the planners), a table
 to `--table`. Runs already in `--runs` are read back, so an interrupted choice resumes.
 
@@ -83,8 +84,10 @@ def choose(args: argparse.Namespace) -> dict:
     grid = list(itertools.product(args.radii, args.elevations))
     single = {spec("orbit", (ring,)): score(args, settings, spec("orbit", (ring,))) for ring in grid}
     ranked = sorted(grid, key=lambda ring: -np.mean(list(single[spec("orbit", (ring,))].values())))
-    seconds = list(itertools.product(args.radii, args.second_elevations))
-    pairs = [(first, second) for first in ranked[:args.first] for second in seconds if second[1] > first[1]]
+    radii = args.pair_radii or args.radii
+    firsts = dict.fromkeys([*ranked[:args.first], *itertools.product(radii, args.first_elevations)])
+    seconds = list(itertools.product(radii, args.second_elevations))
+    pairs = [(first, second) for first in firsts for second in seconds if second[1] > first[1]]
     double = {spec("orbit2", pair): score(args, settings, spec("orbit2", pair)) for pair in pairs}
     best2 = max(pairs, key=lambda pair: np.mean(list(double[spec("orbit2", pair)].values())))
     command = "nice -n 5 python " + " ".join(sys.argv)
@@ -107,6 +110,10 @@ def main() -> None:
     parser.add_argument("--second-elevations", type=float, nargs="+", default=[25, 40],
                         help="degrees of orbit2's second ring")
     parser.add_argument("--first", type=int, default=1, help="best single rings tried as orbit2's first")
+    parser.add_argument("--first-elevations", type=float, nargs="+", default=[],
+                        help="degrees of orbit2's other first rings")
+    parser.add_argument("--pair-radii", type=float, nargs="+",
+                        help="metres of orbit2's rings (default: --radii)")
     parser.add_argument("--seeds", type=int, nargs="+", default=[0])
     parser.add_argument("--views", type=int, default=13)
     parser.add_argument("--width", type=int, default=160)

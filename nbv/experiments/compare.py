@@ -22,7 +22,7 @@ the run folders carried over as hard links, so they always describe the same run
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Annotated
 
@@ -37,7 +37,7 @@ from nbv.fanout.config import ExecutorConfig
 from nbv.fanout.task import Task
 from nbv.flight import prefix_flight
 from nbv.planning.config import PlanSettings
-from nbv.planning.registry import entries, planner_specs
+from nbv.planning.registry import compared_planners, entries, planner_specs
 from nbv.viz.figures import plot_planner_comparison
 from scenes.spec import SceneSpec
 
@@ -59,7 +59,7 @@ class CompareConfig:
     """The target."""
     views: int | None = None
     """Number of views; default: the policy's episode, the whole hemisphere, or 13 (paper Fig. 1)."""
-    planners: Annotated[tuple[str, ...], arg(help=planners_help())] = ("random", "circle", "greedy")
+    planners: Annotated[tuple[str, ...], arg(help=planners_help())] = field(default_factory=compared_planners)
     seeds: tuple[int, ...] = (0, 1, 2)
     """Seeds per planner."""
     out: Path

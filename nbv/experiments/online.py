@@ -22,7 +22,7 @@ by side as well as the seeds.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Annotated
 
@@ -36,7 +36,7 @@ from nbv.experiments.paper_numbers import FIG1_NBV, FIG7_GENERALISATION
 from nbv.experiments.planner_study import run_studies, scene_folder
 from nbv.fanout.config import ExecutorConfig
 from nbv.planning.config import PlanSettings
-from nbv.planning.registry import planner_label
+from nbv.planning.registry import compared_planners, planner_label
 from nbv.recon.config import MetricsConfig
 from nbv.viz.figures import plot_seed_scores
 from scenes.spec import SceneSpec
@@ -58,8 +58,9 @@ class OnlineConfig:
     policies: tuple[str, ...] = ("policy",)
     """Policies to evaluate on their mode (policy = the shipped one; policy:CHECKPOINT for others); the
     first is the one the margins and the one-pass table describe."""
-    baselines: tuple[str, ...] = ("random", "circle", "greedy")
-    """Baseline planners at the same view count."""
+    baselines: tuple[str, ...] = field(default_factory=compared_planners)
+    """Baseline planners at the same view count (the registry's compared ones: random, circle, the tuned
+    orbits, greedy)."""
     seeds: tuple[int, ...] = (0, 1, 2, 3, 4)
     """Evaluation seeds per planner and building."""
     views: int = 13
@@ -167,7 +168,7 @@ def online_report(budget: dict[str, dict[str, list[dict]]], one_pass: dict[str, 
              "Planning time per scan, s (all / without the simulated camera, i.e. loading the scene into "
              "the renderer and rendering the views flown to; `plan.json`'s `planning_s` / `deciding_s`): "
              + ", ".join(f"{label} {planning[label]:.2f} / {deciding[label]:.2f}" for label in labels), ""]
-    for other in ("random", "circle", "greedy"):
+    for other in compared_planners():
         if other in overall and policy in overall:
             lines.append(f"- {policy} minus {other}: {overall[policy] - overall[other]:+.1f} points")
     if "greedy" in deciding and policy in deciding:

@@ -15,6 +15,8 @@ planners by name in `registry.py`.
   highest Bag of Views reward (Sec. IV's reward under the plan's `bov` config, no learning).
 - `HemispherePlanner`: the full-coverage hemisphere scan (Sec. V-B), the
   paper's reference.
+- `OrbitPlanner` (`orbit.py`): one or two fixed rings from the start view's
+  azimuth (`orbit`, `orbit2`), the rings chosen on the training buildings.
 - `InfoGainPlanner` (`infogain.py`): greedy on volumetric information gain,
   the unknown voxels a candidate would see in an occupancy grid built from the
   depth of the views flown to (model-free, geometric, no appearance).

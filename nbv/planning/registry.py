@@ -6,7 +6,8 @@ the command line lists the planners without loading torch or a renderer. Every l
 adding a planner is its own file plus one entry below.
 
 A spec names a planner, optionally with a checkpoint: `policy:runs/x/policy.pt`. An entry that takes a
-checkpoint (`checkpoint=True`) runs the shipped policy (`SHIPPED_POLICY`) without one.
+checkpoint (`checkpoint=True`) runs the shipped policy (`SHIPPED_POLICY`) without one. An entry with an
+`argument` takes that instead (`orbit:2.0,5`); without one it runs its shipped choice.
 """
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ class PlannerEntry:
     """One line: the `--help` and docs text."""
     factory: str
     """"module:callable", imported lazily; callable(settings: PlanSettings, seed: int,
-    checkpoint: str | None) -> Planner."""
+    checkpoint: str | None) -> Planner (the checkpoint, or the `argument`, after the ':'; None without)."""
     settings: tuple[str, ...] = ()
     """The `PlanSettings` fields it reads (e.g. ("candidates", "occupancy"))."""
     reads_truth: bool = False
@@ -48,21 +49,40 @@ class PlannerEntry:
     budget: bool = True
     """One of the budget study's default planners (False: the fixed hemisphere scan, the policy's sampled
     twin)."""
+    argument: str | None = None
+    """What a ':ARG' after the name gives, as the help writes it (e.g. "R,ELEVATION"); None: none (a
+    checkpoint entry takes CHECKPOINT)."""
+    compared: bool = False
+    """One of the baselines `nbv compare` and `nbv online` run by default."""
+    tuned: bool = False
+    """A fixed pattern chosen on the training buildings (the tuned orbits): the demo's online half flies it
+    beside the policy and random views."""
 
     @property
     def spec(self) -> str:
-        """How the spec is written: the name, with `[:CHECKPOINT]` when it takes one."""
-        return f"{self.name}[:CHECKPOINT]" if self.checkpoint else self.name
+        """How the spec is written: the name, with `[:CHECKPOINT]` (or `[:ARGUMENT]`) when it takes one."""
+        takes = "CHECKPOINT" if self.checkpoint else self.argument
+        return f"{self.name}[:{takes}]" if takes else self.name
 
 
 PLANNERS: tuple[PlannerEntry, ...] = (
     PlannerEntry("random", "viewpoints uniform in the allowed ranges (seeded)",
-                 "nbv.planning.planners:random_planner"),
+                 "nbv.planning.planners:random_planner", compared=True),
     PlannerEntry("circle", "evenly spaced azimuths at the middle radius and elevation",
-                 "nbv.planning.planners:circle_planner", prefixes=False),
+                 "nbv.planning.planners:circle_planner", prefixes=False, compared=True),
+    PlannerEntry("orbit", "one ring: evenly spaced azimuths from the start view's azimuth at a fixed radius "
+                 "and elevation, the ring chosen on the training buildings (nbv/planning/shipped/orbit.json, "
+                 "scripts/choose_orbit.py), or orbit:R,ELEVATION (metres, degrees)",
+                 "nbv.planning.orbit:orbit_planner", prefixes=False, argument="R,ELEVATION", compared=True,
+                 tuned=True),
+    PlannerEntry("orbit2", "two rings flown one after the other in the same direction, the views split "
+                 "half-half (the first ring takes the odd one), the second's azimuths half a step on: the "
+                 "pair chosen on the training buildings, or orbit2:R1,E1,R2,E2",
+                 "nbv.planning.orbit:orbit2_planner", prefixes=False, argument="R1,E1,R2,E2", compared=True,
+                 tuned=True),
     PlannerEntry("greedy", "greedy Bag of Views: from the start view, render K (--candidates) random "
                  "candidates per step, move to the one of highest Bag of Views reward (no learning)",
-                 "nbv.planning.planners:greedy_planner", settings=("candidates", "bov")),
+                 "nbv.planning.planners:greedy_planner", settings=("candidates", "bov"), compared=True),
     PlannerEntry("hemisphere", "the full hemisphere scan at the middle radius (288 views with the default "
                  "camera)", "nbv.planning.planners:hemisphere_planner", prefixes=False, budget=False),
     PlannerEntry("infogain", "volumetric information gain (model-free, from depth): move to the one of K "
@@ -107,16 +127,17 @@ def entries() -> tuple[PlannerEntry, ...]:
 
 
 def entry(spec: str) -> PlannerEntry:
-    """The entry of a spec (`name` or `name:CHECKPOINT`); a ValueError listing every planner if unknown."""
+    """The entry of a spec (`name`, `name:CHECKPOINT` or `name:ARGUMENT`); a ValueError listing every
+    planner if unknown."""
     name, sep, _ = spec.partition(":")
     found = _REGISTERED.get(name)
-    if found is None or (sep and not found.checkpoint):
+    if found is None or (sep and not (found.checkpoint or found.argument)):
         raise ValueError(f"unknown planner {spec!r}; use {', '.join(e.spec for e in entries())}")
     return found
 
 
 def split_spec(spec: str) -> tuple[PlannerEntry, str | None]:
-    """The entry of a spec and its checkpoint (None where none is named)."""
+    """The entry of a spec and its checkpoint or argument (None where none is named)."""
     found = entry(spec)
     _, sep, checkpoint = spec.partition(":")
     return found, checkpoint if sep else None
@@ -137,6 +158,8 @@ def planner_label(spec: str) -> str:
     found, checkpoint = split_spec(spec)
     if found.checkpoint:
         return f"{found.name}-{Path(checkpoint or SHIPPED_POLICY).resolve().parent.name}"  # policy-shipped
+    if checkpoint:
+        return f"{found.name}-{checkpoint.replace(',', '_')}"  # orbit:2.0,5 -> orbit-2.0_5
     return spec
 
 
@@ -168,6 +191,16 @@ def docs_table() -> str:
 def budget_planners() -> tuple[str, ...]:
     """The budget study's default planners: every entry with `budget` set, in registry order."""
     return tuple(e.name for e in entries() if e.budget)
+
+
+def compared_planners() -> tuple[str, ...]:
+    """The default baselines of `nbv compare` and `nbv online`: every entry with `compared` set."""
+    return tuple(e.name for e in entries() if e.compared)
+
+
+def tuned_planners() -> tuple[str, ...]:
+    """The fixed patterns chosen on the training buildings: every entry with `tuned` set."""
+    return tuple(e.name for e in entries() if e.tuned)
 
 
 def replanned() -> tuple[str, ...]:

@@ -40,6 +40,7 @@ def test_demo_runs_every_stage_and_reuses_its_scan(tmp_path, capsys):
     printed = capsys.readouterr().out
     assert "| refined |" in printed and "Paper (Table 2" in printed
     assert "## Online half: test_building (held out)" in printed and "| random | " in printed
+    assert "| orbit | " in printed and "| orbit2 | " in printed
     results = json.loads((tmp_path / "results.json").read_text())
     assert 0 < results["views_refined"] <= results["views_full"]
     for ref in ("gt", "reference"):
@@ -54,6 +55,7 @@ def test_demo_runs_every_stage_and_reuses_its_scan(tmp_path, capsys):
     stamp = (tmp_path / "full_scan" / "transforms.json").stat().st_mtime_ns
     online = results["online"]
     assert 2 <= online["policy"]["views"] <= 4 and online["random"]["views"] == online["policy"]["views"]
+    assert online["orbit"]["views"] == online["orbit2"]["views"] == online["policy"]["views"]  # tuned orbits
     assert 0 < online["policy"]["gt"]["coverage"] <= 1
     assert online["policy"]["flight_m"] > 0 and "| flight (m) | azimuth reversals |" in printed
     assert (tmp_path / "online_policy" / "trajectory.png").is_file()

@@ -42,7 +42,8 @@ def test_online_report_from_saved_runs(tmp_path):
         for seed in (0, 1):
             save_run(root / "onepass" / f"policy-shipped-seed{seed}", 10 + seed, 0.75, 0.4)
     config = OnlineConfig(out=tmp_path, scenes=("alpine_chalet", "random:5"), seeds=(0, 1),
-                          policies=("policy", f"policy:{tmp_path / 'seed1' / 'policy.pt'}"))
+                          policies=("policy", f"policy:{tmp_path / 'seed1' / 'policy.pt'}"),
+                          baselines=("random", "circle", "greedy"))
     text = run_online(config)
     assert "| **mean** | **85.0** | **75.0** | **70.0** | **60.0** | **85.0** |" in text
     assert "- policy-shipped minus random: +15.0 points" in text
@@ -83,9 +84,11 @@ def test_online_hands_every_run_of_every_building_to_the_executor_at_once(tmp_pa
     stages = [comparison_tasks(comparison) for comparison in comparisons(config)]
     references = unique_tasks([task for refs, _ in stages for task in refs])
     runs = unique_tasks([task for _, plans in stages for task in plans])
-    # one reference per building (both protocols share it); 4 planners x 2 seeds at 13 views, + one pass
+    # one reference per building (both protocols share it); the policy and the registry's 5 compared
+    # baselines (random, circle, orbit, orbit2, greedy) x 2 seeds at 13 views, + one pass
+    assert config.baselines == ("random", "circle", "orbit", "orbit2", "greedy")
     assert [task.name for task in references] == ["full-scan reference of alpine_chalet",
                                                   "full-scan reference of random:5"]
-    assert len(runs) == 2 * (4 * 2 + 2)
+    assert len(runs) == 2 * (6 * 2 + 2)
     assert runs[-1].name == f"policy-shipped-seed1 in {tmp_path}/random_5/onepass"
     assert runs[-1].result == tmp_path / "random_5" / "onepass" / "policy-shipped-seed1" / "plan.json"

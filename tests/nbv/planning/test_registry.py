@@ -16,7 +16,8 @@ from render.viewpoint import Viewpoint
 from scenes.spec import SceneSpec
 
 ROOT = Path(__file__).resolve().parents[3]
-SHIPPED = ("random", "circle", "greedy", "hemisphere", "infogain", "policy", "policy-sample", "oracle")
+SHIPPED = ("random", "circle", "orbit", "orbit2", "greedy", "hemisphere", "infogain", "policy",
+           "policy-sample", "oracle")
 
 
 class ToyPlanner(Planner):
@@ -86,8 +87,8 @@ def test_the_docs_list_the_registrys_planners():
 def test_the_study_lists_come_from_the_registry():
     from nbv.experiments.budget import PLANNERS, REPLANNED
 
-    assert PLANNERS == ("random", "circle", "greedy", "infogain", "policy", "oracle")
-    assert REPLANNED == ("circle", "oracle")
+    assert PLANNERS == ("random", "circle", "orbit", "orbit2", "greedy", "infogain", "policy", "oracle")
+    assert REPLANNED == ("circle", "orbit", "orbit2", "oracle")
 
 
 def test_a_registered_planner_is_in_the_help_and_plans_end_to_end(toy, tmp_path, capsys, monkeypatch):

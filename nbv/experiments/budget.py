@@ -32,10 +32,12 @@ from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import config_record, git_commit, run_cache
 from nbv.experiments.budget_flight import METRES, flight_markdown, flight_tables
 from nbv.experiments.planner_study import PlannerStudy, StudyRun, run_study
+from nbv.experiments.sfm_columns import planned_sfm_table
 from nbv.fanout.config import ExecutorConfig
 from nbv.planning.config import PlanSettings
 from nbv.planning.registry import budget_planners, replanned
 from nbv.recon.config import MetricsConfig
+from nbv.sfm.config import SfmOption
 from nbv.viz.paper import plot_budget_curves, plot_coverage_metres
 
 BUDGETS = (5, 9, 13, 20)
@@ -55,8 +57,8 @@ SETTINGS = PlanSettings(full_scan=False, metrics=MetricsConfig(n_points=200_000)
 
 
 @dataclass(frozen=True, kw_only=True)
-class BudgetConfig:
-    """Settings of the coverage-against-budget study."""
+class BudgetConfig(SfmOption):
+    """Settings of the coverage-against-budget study (--sfm: every plan also runs structure from motion)."""
 
     out: Path = Path("paper_results/budget")
     """Folder for budget.{md,json,png}."""
@@ -88,7 +90,7 @@ class BudgetConfig:
         """The budget curves as a planner study whose runs live in `runs` (`RUNS`)."""
         return PlannerStudy(scenes=self.scenes, planners=self.planners, seeds=self.seeds,
                             budgets=self.budgets, curves=True, settings=self.settings, out=runs, runs=RUNS,
-                            executor=self.executor)
+                            executor=self.executor, sfm=self.sfm, sfm_settings=self.sfm_settings)
 
 
 def coverage_auc(budgets: tuple[int, ...], coverage: list[float]) -> float:
@@ -131,13 +133,23 @@ def run_budget(config: BudgetConfig) -> dict[str, list[dict[str, Any]]]:
     record = config_record(config, omit=("executor",))
     with atomic_folder(config.out, overwrite=True, outputs=OUTPUTS) as out:
         write_text(out / "budget.md", budget_markdown(rows, config)
-                   + flight_markdown(flight, config.budgets, config.metres))
+                   + flight_markdown(flight, config.budgets, config.metres) + budget_sfm(runs, config))
         plot_budget_curves(rows, config.budgets, out / "budget.png")
         plot_coverage_metres(rows["coverage"], flight["flight_m"], out / "budget_metres.png")
         write_json(out / "budget.json", {
             "commit": git_commit(), "config": record, "rows": rows, "flight": flight,
             "curves": {m: {f"{s}/{p}": c for (s, p), c in by.items()} for m, by in curves.items()}})
     return rows
+
+
+def budget_sfm(runs: list[StudyRun], config: BudgetConfig) -> str:
+    """With --sfm, the structure-from-motion section of budget.md: one row per plan (a sequential
+    planner's largest one only: its prefixes are not reconstructed); else nothing."""
+    if not config.sfm:
+        return ""
+    return ("\n\n## Structure from motion (COLMAP) on each plan's views: views registered in the largest "
+            "model per seed, models, its mean camera-centre error after a similarity fit\n\n"
+            + planned_sfm_table(runs) + "\n")
 
 
 def budget_rows(curves: dict[tuple[str, str], list[list[float]]], budgets: tuple[int, ...]) -> list[dict]:

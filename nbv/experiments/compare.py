@@ -33,11 +33,13 @@ from common.io import atomic_folder, write_json, write_text
 from common.provenance import config_record, git_commit
 from nbv.experiments.paper_numbers import FIG1_NBV
 from nbv.experiments.planner_study import PlannerStudy, plan_units, reference_units, run_study
+from nbv.experiments.sfm_columns import SFM_HEADER, sfm_cells, sfm_entry
 from nbv.fanout.config import ExecutorConfig
 from nbv.fanout.task import Task
 from nbv.flight import prefix_flight
 from nbv.planning.config import PlanSettings
 from nbv.planning.registry import compared_planners, entries, planner_specs
+from nbv.sfm.config import SfmOption
 from nbv.viz.figures import plot_planner_comparison
 from scenes.spec import SceneSpec
 
@@ -52,8 +54,9 @@ def planners_help() -> str:
 
 
 @dataclass(frozen=True, kw_only=True)
-class CompareConfig:
-    """Settings of `nbv compare`: every `nbv plan` setting but the planner and seed, which it varies."""
+class CompareConfig(SfmOption):
+    """Settings of `nbv compare`: every `nbv plan` setting but the planner and seed, which it varies
+    (--sfm: every run also runs structure from motion, its registration in the table)."""
 
     scene: SceneSpec
     """The target."""
@@ -83,7 +86,7 @@ class CompareConfig:
         """The comparison as a planner study: one building, one budget, every run under `out`."""
         return PlannerStudy(scenes=(self.scene.scene,), up_axis=self.scene.up_axis, planners=self.planners,
                             seeds=self.seeds, budgets=(self.views,), settings=self.settings, out=self.out,
-                            executor=self.executor)
+                            executor=self.executor, sfm=self.sfm, sfm_settings=self.sfm_settings)
 
 
 COMPARED = (("coverage", "reference", 100.0, "coverage % (ref)"),
@@ -116,7 +119,7 @@ def compare_planners(config: CompareConfig) -> str:
         doc = run.plan()
         runs.append({"planner": run.label, "seed": run.seed,
                      **{k: doc[k] for k in ("views", "gt", "reference", "planning_s", "deciding_s")},
-                     **prefix_flight(doc)})
+                     **prefix_flight(doc), **({"sfm": sfm_entry(doc["sfm"])} if config.sfm else {})})
     scene = config.scene.scene
     table = comparison_table(runs, scene, config.settings.metrics.threshold_cm)
     record = config_record(config, omit=("executor",))
@@ -131,8 +134,11 @@ def compare_planners(config: CompareConfig) -> str:
 
 
 def comparison_table(runs: list[dict], scene: str, threshold_cm: float) -> str:
-    """A Markdown table, one row per planner (mean +- std over its runs), the paper's Fig. 1 last."""
-    header = ["planner", "views", *(label for *_, label in COMPARED), *(label for *_, label in FLOWN)]
+    """A Markdown table, one row per planner (mean +- std over its runs), the paper's Fig. 1 last; runs
+    with an `sfm` entry (--sfm) add the `SFM_HEADER` columns."""
+    sfm = [SFM_HEADER] if runs and "sfm" in runs[0] else []
+    header = ["planner", "views", *(label for *_, label in COMPARED), *(label for *_, label in FLOWN),
+              *(label for labels in sfm for label in labels)]
     lines = [f"Planners on {scene}: mean ± std over seeds; coverage within {threshold_cm:g} cm; "
              "ref = the full 288-view scan's reconstruction, gt = the ground-truth mesh; flight: metres "
              "along the viewing shell from the start view through the views in order", "",
@@ -143,10 +149,11 @@ def comparison_table(runs: list[dict], scene: str, threshold_cm: float) -> str:
         for metric, against, scale, _ in COMPARED:
             cells.append(_mean_std([scale * r[against][metric] for r in mine], "{:.2f}"))
         cells += [_mean_std([r[key] for r in mine], fmt) for key, fmt, _ in FLOWN]
+        cells += sfm_cells([r["sfm"] for r in mine]) if sfm else []
         lines.append("| " + " | ".join(cells) + " |")
     paper = [f"{scale * FIG1_NBV[metric]:.2f}" if against == "reference" else "-"
              for metric, against, scale, _ in COMPARED]
-    paper += ["-"] * len(FLOWN)  # the paper counts no flight
+    paper += ["-"] * (len(FLOWN) + len(sfm and SFM_HEADER))  # the paper counts no flight, runs no SfM
     lines.append("| paper Fig. 1 (SAC policy, vs 288-view scan) | 13 | " + " | ".join(paper) + " |")
     return "\n".join(lines) + "\n"
 

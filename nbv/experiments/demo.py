@@ -37,12 +37,14 @@ from nbv.bov.config import BoVConfig
 from nbv.bov.refine import Progress, RefineConfig, refine_dataset
 from nbv.experiments.paper_numbers import FIG7_GENERALISATION, FULL_SCAN_VIEWS, SEC7_SUMMARY, TABLE2
 from nbv.experiments.planner_study import PlannerStudy, run_study
+from nbv.experiments.sfm_columns import SFM_HEADER, sfm_cells, sfm_entry
 from nbv.experiments.study import FullScanStudy
 from nbv.planning.config import PlanSettings
 from nbv.planning.registry import tuned_planners
 from nbv.recon.heatmap import write_heatmap
 from nbv.recon.metrics import SurfaceMetrics, evaluate_surfaces
 from nbv.recon.tsdf import Reconstruction, reconstruct_dataset, save_reconstruction
+from nbv.sfm.config import SfmOption
 from nbv.viz.figures import contact_sheet, plot_trajectory
 from render.dataset import ViewDataset, read_dataset
 from scenes.catalog import DEFAULT_SCENE
@@ -51,13 +53,14 @@ from scenes.model import Scene
 OUTPUTS = ("refined", "recon_full", "recon_refined", "contact_sheet.png", "trajectory_full.png",
            "trajectory_refined.png", "heatmap_refined_vs_full.png", "heatmap_refined_vs_full.ply",
            "heatmap_full_vs_gt.png", "heatmap_full_vs_gt.ply", "results.json", "results.md", "online_policy",
-           "online_random", *(f"online_{name}" for name in tuned_planners()))
+           "online_random", *(f"online_{name}" for name in tuned_planners()), "sfm_full", "sfm_refined")
 """What one demo run writes into `--out`, all together (the cached `full_scan/` beside them is kept)."""
 
 
 @dataclass(frozen=True, kw_only=True)
-class DemoConfig(FullScanStudy):
-    """Settings of `nbv demo`."""
+class DemoConfig(FullScanStudy, SfmOption):
+    """Settings of `nbv demo` (--sfm: COLMAP on the full and the refined set, sfm_full/ and sfm_refined/,
+    and on the online half's runs; off by default: minutes on the full scan)."""
 
     out: Path = Path("demo_out")
     """Folder for the datasets, reconstructions, figures and tables."""
@@ -129,6 +132,7 @@ def demo_stages(config: DemoConfig, scene: Scene, full: ViewDataset, folder: Pat
         }
     with clock.stage("figures_s"):
         figures = draw_figures(config, scene.name, full, recon_full, recon_refined, gt, folder)
+    sfm = sfm_stage(config, full, folder, clock) if config.sfm else {}
     online = {}
     if config.online:
         with clock.stage("online_s"):
@@ -144,8 +148,23 @@ def demo_stages(config: DemoConfig, scene: Scene, full: ViewDataset, folder: Pat
         "timings": clock.seconds,
         "figures": {k: str(out / Path(v).name) for k, v in figures.items()},
         "online": online,
+        **({"sfm": sfm} if config.sfm else {}),
     }
     return results, results_table(results, metrics)
+
+
+def sfm_stage(config: DemoConfig, full: ViewDataset, folder: Path, clock: Stopwatch) -> dict[str, Any]:
+    """COLMAP on the full scan and on the refined set (`folder/refined`) into `folder/sfm_full` and
+    `folder/sfm_refined`; each set's headline (`nbv.sfm.check.sfm_summary`)."""
+    from nbv.sfm.check import sfm_summary  # pycolmap only when asked for
+
+    record = {"command": "nbv demo", "config": config_record(config)}
+    found = {}
+    for name, dataset in (("full", full), ("refined", read_dataset(folder / "refined"))):
+        with clock.stage(f"sfm_{name}_s"):
+            found[name] = sfm_summary(dataset, config.sfm_settings, config.seed, folder / f"sfm_{name}",
+                                      record)
+    return found
 
 
 def online_study(config: DemoConfig, folder: Path, name: str, planner: str,
@@ -157,14 +176,15 @@ def online_study(config: DemoConfig, folder: Path, name: str, planner: str,
                             metrics=config.metrics, full_scan=False)
     return PlannerStudy(scenes=(config.online_scene,), up_axis=config.up_axis, planners=(planner,),
                         seeds=(config.seed,), budgets=(views,), settings=settings, out=folder,
-                        runs=f"online_{name}")
+                        runs=f"online_{name}", sfm=config.sfm, sfm_settings=config.sfm_settings)
 
 
 def online_half(config: DemoConfig, folder: Path) -> dict[str, dict[str, Any]]:
     """The policy's one pass around `online_scene`, then random views and the registry's tuned orbits
     (`tuned_planners`) at its count: `nbv plan` runs."""
     policy = run_study(online_study(config, folder, "policy", config.policy, None))[0].plan()
-    keep, runs = ("views", "planning_s", "gt", "flight_m", "azimuth_reversals"), {"policy": policy}
+    keep = ("views", "planning_s", "gt", "flight_m", "azimuth_reversals", *(("sfm",) if config.sfm else ()))
+    runs = {"policy": policy}
     for name in ("random", *tuned_planners()):
         runs[name] = run_study(online_study(config, folder, name, name, policy["views"]))[0].plan()
     return {name: {k: plan[k] for k in keep} for name, plan in runs.items()}
@@ -228,4 +248,17 @@ def results_table(results: dict[str, Any], metrics: dict[str, dict[str, SurfaceM
                   "Trajectory: online_policy/trajectory.png. Paper Fig. 7 (vs its full scan): "
                   + ", ".join(f"{k} Hausdorff {v['hausdorff_cm']} cm, Chamfer {v['chamfer_cm']} cm"
                               for k, v in FIG7_GENERALISATION.items()) + ".", ""]
-    return "\n".join(lines)
+    return "\n".join(lines + sfm_lines(results))
+
+
+def sfm_lines(results: dict[str, Any]) -> list[str]:
+    """With --sfm, the demo's structure-from-motion table: the full and the refined set, then the online
+    half's runs; else none."""
+    if "sfm" not in results:
+        return []
+    sets = {f"{name} set": doc for name, doc in results["sfm"].items()}
+    sets.update({f"online {name}": run["sfm"] for name, run in results["online"].items()})
+    rows = [[name, *sfm_cells([sfm_entry(doc)])] for name, doc in sets.items()]
+    return ["## Structure from motion (COLMAP): views registered in the largest model, models, its mean "
+            "camera-centre error after a similarity fit (sfm_full/, sfm_refined/, online_*/sfm/)", "",
+            markdown_table(["view set", *SFM_HEADER], rows), ""]

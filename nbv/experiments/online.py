@@ -34,10 +34,12 @@ from common.provenance import config_record, git_commit
 from nbv.experiments.compare import CompareConfig, compare_planners
 from nbv.experiments.paper_numbers import FIG1_NBV, FIG7_GENERALISATION
 from nbv.experiments.planner_study import run_studies, scene_folder
+from nbv.experiments.sfm_columns import sfm_table
 from nbv.fanout.config import ExecutorConfig
 from nbv.planning.config import PlanSettings
 from nbv.planning.registry import compared_planners, planner_label
 from nbv.recon.config import MetricsConfig
+from nbv.sfm.config import SfmOption
 from nbv.viz.figures import plot_seed_scores
 from scenes.spec import SceneSpec
 
@@ -48,8 +50,8 @@ OUTPUTS = ("online.md", "online.json", "online.png")
 
 
 @dataclass(frozen=True, kw_only=True)
-class OnlineConfig:
-    """Settings of `nbv online`."""
+class OnlineConfig(SfmOption):
+    """Settings of `nbv online` (--sfm: every run also runs structure from motion, reported per run)."""
 
     out: Path
     """Folder of the per-building comparisons and of online.{md,json,png}."""
@@ -85,7 +87,7 @@ def comparisons(config: OnlineConfig) -> list[CompareConfig]:
     found = []
     for scene in config.scenes:
         common = {"scene": SceneSpec(scene=scene), "settings": config.settings, "seeds": config.seeds,
-                  "executor": config.executor}
+                  "executor": config.executor, "sfm": config.sfm, "sfm_settings": config.sfm_settings}
         folder = Path(config.out) / scene_folder(scene)
         found.append(CompareConfig(**common, views=config.views, out=folder / f"views{config.views}",
                                    planners=(*config.policies, *config.baselines)))
@@ -183,7 +185,17 @@ def online_report(budget: dict[str, dict[str, list[dict]]], one_pass: dict[str, 
     if one_pass:
         lines += ["", "## One pass around the target (the paper's protocol), against the full 288-view scan",
                   "", _one_pass_table(one_pass, policy)]
+    if config.sfm:
+        lines += _sfm_section(budget, one_pass, config.views)
     return "\n".join(lines) + "\n"
+
+
+def _sfm_section(budget: dict[str, dict[str, list[dict]]], one_pass: dict[str, dict[str, list[dict]]],
+                 views: int) -> list[str]:
+    lines = ["", f"## Structure from motion (COLMAP) on each scan's views ({views} views"
+             + (", then one pass" if one_pass else "") + "): views registered in the largest model per seed, "
+             "models, its mean camera-centre error after a similarity fit", "", sfm_table(budget)]
+    return lines + (["", sfm_table(one_pass)] if one_pass else [])
 
 
 def _flight_table(budget: dict[str, dict[str, list[dict]]], labels: list[str]) -> str:

@@ -35,6 +35,7 @@ from nbv.recon.fused_coverage import as_stored
 from nbv.recon.metrics import evaluate_surfaces, load_geometry
 from nbv.recon.tsdf import reconstruct_dataset
 from nbv.recon.visibility import scene_visibility
+from nbv.sfm.config import SfmOption
 from render.dataset import read_dataset
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes.spec import MeshOrientation, SceneSpec
@@ -46,8 +47,9 @@ RUN_FIELDS = ("scene", "planner", "views", "seed")
 
 
 @dataclass(frozen=True, kw_only=True)
-class PlannerStudy(MeshOrientation):
-    """Planners x seeds x buildings x view budgets, every run under the same plan settings."""
+class PlannerStudy(MeshOrientation, SfmOption):
+    """Planners x seeds x buildings x view budgets, every run under the same plan settings (with --sfm
+    every plan run also runs structure from motion on its views: `SfmOption`)."""
 
     scenes: tuple[str, ...]
     """Buildings: built-in names, random:SEED or mesh files (read with `up_axis`)."""
@@ -135,7 +137,7 @@ def plan_config(study: PlannerStudy, scene: str, planner: str, seed: int, views:
     """The `nbv plan` run of one building, planner, seed and budget under the study's settings."""
     return PlanConfig(scene=scene_spec(study, scene), views=views, planner=planner, seed=seed,
                       out=run_folder(study, scene, planner, seed, views), overwrite=True,
-                      settings=study.settings)
+                      settings=study.settings, sfm=study.sfm, sfm_settings=study.sfm_settings)
 
 
 def reference_units(study: PlannerStudy) -> list[Task]:
@@ -146,8 +148,14 @@ def reference_units(study: PlannerStudy) -> list[Task]:
                  {"scene": scene_spec(study, scene), "settings": study.settings}) for scene in study.scenes]
 
 
+def plan_result(config: PlanConfig) -> Path:
+    """The file whose presence marks a plan run done: its plan.json, or with --sfm its sfm/sfm.json (written
+    with it), so a run made without SfM is redone with it."""
+    return config.out / "sfm" / "sfm.json" if config.sfm else config.out / "plan.json"
+
+
 def plan_units(study: PlannerStudy) -> list[Task]:
-    """One `plan_scan` per building, planner, seed and planned budget, done once its `plan.json` exists."""
+    """One `plan_scan` per building, planner, seed and planned budget, done once its `plan_result` exists."""
     units = []
     for scene in study.scenes:
         for planner in study.planners:
@@ -155,7 +163,7 @@ def plan_units(study: PlannerStudy) -> list[Task]:
                 for views in planned_budgets(study, planner):
                     config = plan_config(study, scene, planner, seed, views)
                     units.append(Task(f"{config.out.name} in {config.out.parent}", plan_scan,
-                                      {"config": config}, config.out / "plan.json"))
+                                      {"config": config}, plan_result(config)))
     return units
 
 

@@ -17,7 +17,7 @@ from common.memory import check_memory
 from nbv.bov.config import BoVConfig
 from nbv.planning.registry import entry, planner_help
 from nbv.recon.config import MetricsConfig, OccupancyConfig, ReconstructionConfig
-from nbv.sfm.config import SfmSettings
+from nbv.sfm.config import SfmOption
 from render.camera import UAVCamera
 from render.scan import check_views
 from render.settings import RenderSettings
@@ -54,8 +54,8 @@ class PlanSettings:
 
 
 @dataclass(frozen=True, kw_only=True)
-class PlanConfig:
-    """Settings of `nbv plan`."""
+class PlanConfig(SfmOption):
+    """Settings of `nbv plan` (--sfm: `SfmOption`)."""
 
     scene: SceneSpec
     """The target."""
@@ -71,11 +71,6 @@ class PlanConfig:
     """Replace a non-empty output folder."""
     settings: Annotated[PlanSettings, arg(name="")] = PlanSettings()
     """What every planned scan of a study shares."""
-    sfm: bool = False
-    """Also run COLMAP's structure from motion on the captured views (`nbv sfm`): out/sfm/ (models,
-    sfm.json) and the registration and pose errors in plan.json's `sfm`, beside coverage."""
-    sfm_settings: SfmSettings = SfmSettings()
-    """How COLMAP reconstructs the plan's views (with --sfm)."""
 
     def __post_init__(self) -> None:
         if self.views is not None and self.views < 1:

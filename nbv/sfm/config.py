@@ -44,6 +44,19 @@ class SfmSettings:
 
 
 @dataclass(frozen=True, kw_only=True)
+class SfmOption:
+    """Whether a command that captures view sets (`nbv plan`, the planner studies, the demo) also runs
+    structure from motion on them, and how: one flag name everywhere (--sfm)."""
+
+    sfm: bool = False
+    """Also run COLMAP's structure from motion on the captured views (`nbv sfm`): a plan's out/sfm/ (models,
+    sfm.json) and the registration and pose errors in plan.json's `sfm`, beside coverage; the studies'
+    tables gain the registered views, models and camera-centre error."""
+    sfm_settings: SfmSettings = SfmSettings()
+    """How COLMAP reconstructs the views (with --sfm)."""
+
+
+@dataclass(frozen=True, kw_only=True)
 class SfmConfig:
     """Settings of `nbv sfm`: COLMAP's structure from motion on a view dataset, scored against its poses."""
 

@@ -136,9 +136,8 @@ def compare_planners(config: CompareConfig) -> str:
 def comparison_table(runs: list[dict], scene: str, threshold_cm: float) -> str:
     """A Markdown table, one row per planner (mean +- std over its runs), the paper's Fig. 1 last; runs
     with an `sfm` entry (--sfm) add the `SFM_HEADER` columns."""
-    sfm = [SFM_HEADER] if runs and "sfm" in runs[0] else []
-    header = ["planner", "views", *(label for *_, label in COMPARED), *(label for *_, label in FLOWN),
-              *(label for labels in sfm for label in labels)]
+    sfm = SFM_HEADER if runs and "sfm" in runs[0] else ()
+    header = ["planner", "views", *(label for *_, label in COMPARED), *(label for *_, label in FLOWN), *sfm]
     lines = [f"Planners on {scene}: mean ± std over seeds; coverage within {threshold_cm:g} cm; "
              "ref = the full 288-view scan's reconstruction, gt = the ground-truth mesh; flight: metres "
              "along the viewing shell from the start view through the views in order", "",
@@ -153,7 +152,7 @@ def comparison_table(runs: list[dict], scene: str, threshold_cm: float) -> str:
         lines.append("| " + " | ".join(cells) + " |")
     paper = [f"{scale * FIG1_NBV[metric]:.2f}" if against == "reference" else "-"
              for metric, against, scale, _ in COMPARED]
-    paper += ["-"] * (len(FLOWN) + len(sfm and SFM_HEADER))  # the paper counts no flight, runs no SfM
+    paper += ["-"] * (len(FLOWN) + len(sfm))  # the paper counts no flight, runs no SfM
     lines.append("| paper Fig. 1 (SAC policy, vs 288-view scan) | 13 | " + " | ".join(paper) + " |")
     return "\n".join(lines) + "\n"
 

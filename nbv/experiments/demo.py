@@ -32,7 +32,7 @@ from typing import Any
 import trimesh
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
-from common.provenance import config_record, git_commit
+from common.provenance import config_record, git_commit, run_record
 from nbv.bov.config import BoVConfig
 from nbv.bov.refine import Progress, RefineConfig, refine_dataset
 from nbv.experiments.paper_numbers import FIG7_GENERALISATION, FULL_SCAN_VIEWS, SEC7_SUMMARY, TABLE2
@@ -158,7 +158,7 @@ def sfm_stage(config: DemoConfig, full: ViewDataset, folder: Path, clock: Stopwa
     `folder/sfm_refined`; each set's headline (`nbv.sfm.check.sfm_summary`)."""
     from nbv.sfm.check import sfm_summary  # pycolmap only when asked for
 
-    record = {"command": "nbv demo", "config": config_record(config)}
+    record = run_record("nbv demo", config)
     found = {}
     for name, dataset in (("full", full), ("refined", read_dataset(folder / "refined"))):
         with clock.stage(f"sfm_{name}_s"):

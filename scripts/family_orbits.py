@@ -68,8 +68,8 @@ def main() -> None:
     parser.add_argument("--rings", nargs="+", default=list(RINGS), help="orbit:R,E specs")
     parser.add_argument("--seeds", type=int, nargs="+", default=[0])
     parser.add_argument("--views", type=int, default=13)
-    parser.add_argument("--width", type=int, default=96)
-    parser.add_argument("--height", type=int, default=72)
+    parser.add_argument("--width", type=int, default=128)
+    parser.add_argument("--height", type=int, default=96)
     parser.add_argument("--spp", type=int, default=1)
     parser.add_argument("--metric-points", type=int, default=100_000)
     args = parser.parse_args()
@@ -77,6 +77,7 @@ def main() -> None:
         parse_family(scene)
         if held_out(scene):
             raise SystemExit(f"{scene} is a held-out building; compare rings on training/validation ones")
+    args.out.mkdir(parents=True, exist_ok=True)
     commit, scores = git_commit(), {}
     for scene in args.scenes:  # the table is rewritten after every run, so a partial one is kept
         scores[scene] = {}

@@ -65,7 +65,7 @@ def parse_family(spec: str) -> int:
         ValueError: not `family:` followed by a non-negative integer.
     """
     seed = spec[len(FAMILY_PREFIX):] if spec.startswith(FAMILY_PREFIX) else ""
-    if not seed.isdigit():
+    if not (seed.isascii() and seed.isdigit()):  # isdigit alone takes '²', which int() refuses
         raise ValueError(f"bad scene {spec!r}: expected family:SEED with SEED a non-negative integer "
                          f"(e.g. family:{family_seeds('train', 1)[0]})")
     return int(seed)

@@ -109,7 +109,7 @@ def test_held_out_covers_presets_random_and_family():
     assert not held_out("medieval_tavern") and not held_out("random:6") and not held_out("family:9")
 
 
-@pytest.mark.parametrize("spec", ["family:x", "family:-1", "family:", "family:1.5"])
+@pytest.mark.parametrize("spec", ["family:x", "family:-1", "family:", "family:1.5", "family:²"])
 def test_bad_family_names_are_refused(spec):
     with pytest.raises(ValueError, match=r"expected family:SEED with SEED a non-negative integer"):
         load_scene(spec)

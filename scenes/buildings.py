@@ -27,14 +27,16 @@ from scenes.surface import Finish, textured_parts
 
 TOWER_SIDES = 12
 """Facets of a round tower (windows sit on flat facets)."""
+GATE_W = 2.4
+"""Width of the gate through a courtyard's front wing, metres (a gap: the plan stays one polygon)."""
 
 
 @dataclass(frozen=True)
 class BuildingSpec:
     """Everything that decides a building's shape and look (lengths in real metres)."""
 
-    footprint: Literal["rectangle", "L", "U", "cross", "tower"] = "rectangle"
-    """Plan shape: one wing, L / U / cross of wings, or a free-standing round tower."""
+    footprint: Literal["rectangle", "L", "U", "cross", "tower", "courtyard"] = "rectangle"
+    """Plan: one wing, L / U / cross of wings, a round tower, or wings round a court (roof hip or flat)."""
     width: float = 12.0
     """Main wing length along x."""
     depth: float = 8.0
@@ -112,6 +114,9 @@ def wings(spec: BuildingSpec) -> list[Rect]:
         return [main, (-w, -d, -w + arm, d + reach), (w - arm, -d, w, d + reach)]
     if spec.footprint == "cross":
         return [main, (-arm / 2, -d - reach, arm / 2, d + reach)]
+    if spec.footprint == "courtyard":  # back wing, front wing either side of the gate, side wings
+        b, g, r = 3 * d + reach, GATE_W / 2, w - arm
+        return [(-w, d + reach, w, b), (-w, -d, -g, d), (g, -d, w, d), (-w, -d, -r, b), (r, -d, w, b)]
     return [main]
 
 
@@ -122,8 +127,8 @@ def _grow(rect: Rect, g: float) -> Rect:
 class _Assembly:
     """One building being assembled: storey heights, outlines and keep-out zones."""
 
-    def __init__(self, spec: BuildingSpec, seed: int) -> None:
-        self.spec, self.rng, self.b = spec, np.random.default_rng(seed), SolidBuilder()
+    def __init__(self, spec: BuildingSpec, seed: int, builder: SolidBuilder | None = None) -> None:
+        self.spec, self.rng, self.b = spec, np.random.default_rng(seed), builder or SolidBuilder()
         self.rects = wings(spec)
         self.base = 0.5 * spec.platform
         self.z = [self.base + spec.plinth_h + i * spec.storey_h for i in range(spec.storeys + 1)]
@@ -414,9 +419,9 @@ class _Assembly:
             self.b.cut(hull(np.array(inner + far)), "broken")
 
 
-def build_building(name: str, spec: BuildingSpec, seed: int = 0) -> Scene:
-    """The normalised, textured `Scene` of `spec` (textures and random details seeded by `seed`)."""
-    a = _Assembly(spec, seed)
+def assemble(spec: BuildingSpec, seed: int, builder: SolidBuilder | None = None) -> SolidBuilder:
+    """The solids of `spec` added to `builder` (a new one if None), in metres; returns the builder."""
+    a = _Assembly(spec, seed, builder)
     a.structure()
     if a.has_tower:
         a.tower()
@@ -428,9 +433,18 @@ def build_building(name: str, spec: BuildingSpec, seed: int = 0) -> Scene:
     a.fittings()
     if spec.ruined:
         a.ruin()
-    parts = textured_parts(a.b.triangles(), spec.finishes, seed)
+    return a.b
+
+
+def textured_scene(name: str, triangles: dict[str, np.ndarray], spec: BuildingSpec, seed: int) -> Scene:
+    """The normalised `Scene` of `triangles` with the finishes, ground and light of `spec`."""
+    parts = textured_parts(triangles, spec.finishes, seed)
     lo = np.min([p.vertices.min(0) for p in parts], axis=0)
     hi = np.max([p.vertices.max(0) for p in parts], axis=0)
-    extent = float(np.max(hi - lo))
-    ground = make_ground(spec.ground, seed, center=(lo + hi)[:2] / 2, half_m=3.2 * extent)
+    ground = make_ground(spec.ground, seed, center=(lo + hi)[:2] / 2, half_m=3.2 * float(np.max(hi - lo)))
     return Scene(name, normalise_parts(parts + [ground]), spec.lighting)
+
+
+def build_building(name: str, spec: BuildingSpec, seed: int = 0) -> Scene:
+    """The normalised, textured `Scene` of `spec` (textures and random details seeded by `seed`)."""
+    return textured_scene(name, assemble(spec, seed).triangles(), spec, seed)

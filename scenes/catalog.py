@@ -1,4 +1,5 @@
-"""Scenes by name: presets, the `random:SEED` family, the test building, mesh and XML files.
+"""Scenes by name: presets, the `random:SEED` and `family:SEED` families, the test building, mesh and XML
+files.
 
 Light to import: the names are listed here and each builder or loader is
 imported when a scene is loaded, so `nbv scene list` starts at once.
@@ -12,6 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from common.io import cache_dir
+from scenes.family_splits import FAMILY_PREFIX, parse_family
 
 if TYPE_CHECKING:
     from scenes.model import Scene
@@ -37,7 +39,7 @@ def list_scenes() -> list[str]:
 
 
 def load_scene(spec: str, up_axis: str = "z") -> Scene:
-    """A scene by built-in name, `random:SEED`, or mesh / Mitsuba XML file path.
+    """A scene by built-in name, `random:SEED`, `family:SEED`, or mesh / Mitsuba XML file path.
 
     A process builds each scene once (a procedural building takes seconds): the scene is kept, its
     arrays made read-only, and given again while its texture files and its mesh file are unchanged.
@@ -64,7 +66,7 @@ def load_scene(spec: str, up_axis: str = "z") -> Scene:
 
 def _memo_key(spec: str, up_axis: str) -> tuple:
     """What a loaded scene depends on: the textures' cache folder, and a mesh file's state and up axis."""
-    if spec in BUILTIN_NAMES or spec.startswith(RANDOM_PREFIX) or not os.path.exists(spec):
+    if spec in BUILTIN_NAMES or spec.startswith((RANDOM_PREFIX, FAMILY_PREFIX)) or not os.path.exists(spec):
         return spec, str(cache_dir())
     state = os.stat(spec)
     return str(Path(spec).resolve()), up_axis, state.st_mtime_ns, state.st_size, str(cache_dir())
@@ -95,11 +97,15 @@ def _build(spec: str, up_axis: str) -> Scene:
         from scenes.presets import build_random
 
         return build_random(int(seed))
+    if spec.startswith(FAMILY_PREFIX):
+        from scenes.family import build_family
+
+        return build_family(parse_family(spec))
     from scenes.loader import is_scene_file, load_file_scene
 
     if is_scene_file(spec):
         return load_file_scene(spec, up_axis)
     raise ValueError(
         f"unknown scene {spec!r}; built-in scenes: {', '.join(list_scenes())}; "
-        f"or random:SEED, or a mesh / Mitsuba XML file path"
+        f"or random:SEED, family:SEED, or a mesh / Mitsuba XML file path"
     )

@@ -31,7 +31,8 @@ class SceneSpec(MeshOrientation):
     """One target, given as the command's positional SCENE."""
 
     scene: Annotated[str, Positional, arg(metavar="SCENE")]
-    """A built-in scene name (see `nbv scene list`), random:SEED, or a mesh / Mitsuba XML file path."""
+    """A built-in scene name (see `nbv scene list`), random:SEED, family:SEED, or a mesh / Mitsuba XML file
+    path."""
 
     def load(self) -> Scene:
         """The normalised scene."""
@@ -45,7 +46,8 @@ class SceneSet(MeshOrientation):
     """One or more targets, each given with `--scene` (the up axis applies to every mesh file)."""
 
     scene: Annotated[tuple[str, ...], UseAppendAction]
-    """A built-in scene name, random:SEED, or a mesh file path; give --scene several times for several."""
+    """A built-in scene name, random:SEED, family:SEED, or a mesh file path; give --scene several times for
+    several."""
 
     def __post_init__(self) -> None:
         if not self.scene:

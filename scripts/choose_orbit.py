@@ -2,10 +2,10 @@
 
 Every ring of a grid (radii x elevations, inside the allowed ranges) is flown as `orbit:R,E` at `--views`
 views on every training building (`nbv.rl.presets.TRAIN_SCENES`; a test building, alpine_chalet,
-imperial_temple or random:SEED with SEED % 5 == 0, is refused), each run an `nbv plan` run of a
-`PlannerStudy` scored by the project's measure: the TSDF reconstruction's coverage of the true surface.
-The ring of the best mean is `orbit`. Then every two-ring pattern whose first ring is one of the
-`--first` best single rings or a ring of the `--pair-radii` (default: the grid's) at a
+imperial_temple, random:SEED with SEED % 5 == 0 or a held-out family:SEED, is refused), each run an
+`nbv plan` run of a `PlannerStudy` scored by the project's measure: the TSDF reconstruction's coverage of
+the true surface. The ring of the best mean is `orbit`. Then every two-ring pattern whose first ring is
+one of the `--first` best single rings or a ring of the `--pair-radii` (default: the grid's) at a
 `--first-elevations` elevation, and whose second is a ring of the `--pair-radii` at a
 `--second-elevations` elevation above the first's, is flown as `orbit2:R1,E1,R2,E2`; the best mean
 is `orbit2`. The choice, the command, the commit, the resolution and
@@ -34,17 +34,13 @@ from nbv.recon.config import MetricsConfig
 from nbv.rl.presets import TRAIN_SCENES
 from render.camera import UAVCamera
 from render.settings import RenderSettings
-from scenes.presets import seed_split
-
-HELD_OUT = ("alpine_chalet", "imperial_temple")
-"""The held-out presets (with the test-split random:SEED buildings): never scored here."""
+from scenes.family_splits import held_out
 
 
 def check_training(scenes: list[str]) -> None:
     """Refuse any test building: the rings are chosen on training buildings only."""
     for scene in scenes:
-        name, _, seed = scene.partition(":")
-        if scene in HELD_OUT or (name == "random" and seed_split(int(seed)) == "test"):
+        if held_out(scene):
             raise SystemExit(f"{scene} is a held-out test building; choose the rings on training buildings")
 
 

@@ -179,6 +179,8 @@ class ScanConfig:
         check_camera_distance("radius", self.plan.radius, self.camera)
         if isinstance(self.plan, CirclePlan) and self.plan.views is not None:
             check_views("views", self.plan.views)
+        if self.seed < 0:
+            raise ValueError(f"--seed must be >= 0, got {self.seed}")
 
     def viewpoints(self) -> list[Viewpoint]:
         """The viewpoints the plan asks for."""

@@ -73,7 +73,8 @@ def select_variant(requested: str | None = None) -> ModuleType:
     """
     name = requested or os.environ.get("NBV_VARIANT") or default_variant()
     if name not in VARIANTS:
-        raise ValueError(f"unknown Mitsuba variant {name!r}; choose one of {', '.join(VARIANTS)}")
+        where = "" if requested else " (from $NBV_VARIANT)"
+        raise ValueError(f"unknown Mitsuba variant {name!r}{where}; choose one of {', '.join(VARIANTS)}")
     if name not in available_variants():
         raise ValueError(f"Mitsuba variant {name!r} is not available on this machine "
                          f"(available: {', '.join(available_variants())})")

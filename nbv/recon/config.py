@@ -96,7 +96,7 @@ class MetricsConfig:
 
     def __post_init__(self) -> None:
         if self.n_points < 1:
-            raise ValueError(f"metrics n_points must be >= 1, got {self.n_points}")
+            raise ValueError(f"--metric-points must be >= 1, got {self.n_points}")
         check_memory(f"metrics n_points (--metric-points) {self.n_points}", self.n_points, METRIC_POINT_BYTES,
                      "use fewer points (default 1000000)")
         if not math.isfinite(self.threshold_cm) or self.threshold_cm <= 0:

@@ -29,6 +29,8 @@ CASES = [
     (SCAN + ["circle", "--views", "None", "--end-overlap", "0.99999999"], "end_overlap"),
     (SCAN + ["--end-overlap", "0.99999999"], "end_overlap"),
     (PLAN + ["--views", "0"], "views"),
+    (PLAN + ["--metric-points", "0"], "--metric-points"),
+    (SCAN + ["--seed", "-5"], "--seed"),
     (TRAIN + ["--gamma", "2"], "gamma"),
     (TRAIN + ["--gamma", "0"], "gamma"),
     (TRAIN + ["--batch-size", "0"], "batch_size"),
@@ -155,6 +157,14 @@ def test_many_frames_sharing_one_image_bounded_by_memory(tmp_path, capsys, monke
     assert last.startswith("nbv refine: error: refine of 500 views"), last
     assert "0.244 GiB" in last and "--max-features" in last
     assert not (tmp_path / "r").exists()
+
+
+def test_unknown_variant_from_the_environment_names_the_variable(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("NBV_VARIANT", "bogus")
+    assert main(["scan", "test_building", "circle", "--views", "2", "--width", "32", "--height", "24",
+                 "--out", str(tmp_path / "scan")]) == 2
+    _one_line_naming(capsys, "unknown Mitsuba variant 'bogus' (from $NBV_VARIANT)")
+    assert not (tmp_path / "scan").exists()
 
 
 def test_tiny_voxel_size_refused(tmp_path, capsys):

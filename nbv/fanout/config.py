@@ -27,3 +27,7 @@ class ExecutorConfig:
             raise ValueError(f"workers must be >= 1, got {self.workers}")
         if self.ray is not None and not self.ray.strip():
             raise ValueError("ray must be 'auto' or a cluster address, got an empty string")
+        if self.ray is not None and self.ray.strip() != "auto":
+            host, colon, port = self.ray.strip().removeprefix("ray://").rpartition(":")
+            if not (colon and host and port.isdigit() and 0 < int(port) < 65536):
+                raise ValueError(f"--ray must be 'auto', HOST:PORT or ray://HOST:PORT, got {self.ray!r}")

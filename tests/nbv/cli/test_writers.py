@@ -230,3 +230,10 @@ def test_ray_address_with_nothing_listening_fails_within_seconds(tmp_path, capsy
     with pytest.raises(ValueError, match=rf"^ray {silent}: nothing answers at 192.0.2.2:9 within 0.2"):
         check_reachable(silent, timeout_s=0.2)
     assert time.monotonic() - start < 3.0
+
+
+def test_ray_address_of_no_known_form_is_refused_naming_the_option(tmp_path, capsys):
+    assert main(["train", "--ray", "garbage-address", "--out", str(tmp_path / "run")]) == 2
+    assert one_line(capsys) == ("nbv train: error: --ray must be 'auto', HOST:PORT or ray://HOST:PORT, "
+                                "got 'garbage-address'")
+    assert sorted(p.name for p in tmp_path.iterdir()) == []

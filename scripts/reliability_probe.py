@@ -50,7 +50,7 @@ TRAIN = (
 )
 SCAN = "nbv scan test_building circle --views 4 $CAM"
 PLAN2 = "nbv plan test_building --planner circle --views 2 --no-full-scan $CAM --out p"
-COMPARE = "nbv compare test_building --planners circle random --seeds 0 --views 2 --no-full-scan $CAM --out c"
+COMPARE = "nbv compare test_building --planners circle random --seeds 0 --views 2 $CAM --out c"
 OUTCOMES = ("passed", "traceback", "vague", "silent", "lost-partial", "hang-memory")
 PARTS = {
     1: "SIGKILL at random moments, symlinked --out, stale temp folders",
@@ -1817,6 +1817,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--only", default="", help="comma-separated case ids or prefixes (e.g. F3,kill-scan)")
     parser.add_argument("--parts", default="", help="comma-separated part numbers")
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--timeout-factor", type=float, default=1.0, help="scale every case's timeout")
     args = parser.parse_args(argv)
     args.scratch = args.scratch.resolve()
     args.scratch.mkdir(parents=True, exist_ok=True)
@@ -1825,6 +1826,8 @@ def main(argv: list[str] | None = None) -> int:
     cases = all_cases(args.scratch)
     if args.only:
         cases = [c for c in cases if any(c.id == o or c.id.startswith(o + "-") for o in args.only.split(","))]
+    for case in cases:
+        case.timeout = int(case.timeout * args.timeout_factor)
     if args.parts:
         cases = [c for c in cases if str(c.part) in args.parts.split(",")]
     commit = subprocess.run(

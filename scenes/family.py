@@ -25,8 +25,8 @@ import numpy as np
 from scenes.buildings import BuildingSpec, assemble, textured_scene
 from scenes.csg import SolidBuilder
 from scenes.family_splits import family_trait
-from scenes.model import Lighting, Scene
-from scenes.presets import _PAINT, _ROOFS, _WALLS, _finishes
+from scenes.model import Scene
+from scenes.presets import _PAINT, _ROOFS, _WALLS, _finishes, random_lighting
 from scenes.solids import box
 from scenes.surface import Finish
 
@@ -78,12 +78,7 @@ def _base(rng: np.random.Generator) -> BuildingSpec:
             trim=Finish(pick(_WALLS)),
             compound_wall=Finish(pick(("stone_rubble", "stone_ashlar", "brick_red"))),
         ),
-        lighting=Lighting(
-            sun_azimuth_deg=float(rng.uniform(0, 360)),
-            sun_elevation_deg=float(rng.uniform(25, 70)),
-            sun_irradiance=float(rng.uniform(2.0, 3.8)),
-            sky_radiance=tuple(float(c) for c in rng.uniform(0.45, 0.75, 3)),
-        ),
+        lighting=random_lighting(rng),
         ground=Finish(pick(("grass", "gravel", "forest_floor"))),
     )
 

@@ -225,6 +225,16 @@ _ROOFS = ("roof_tiles_red", "roof_slate", "roof_shingles", "roof_glazed")
 _PAINT = ("paint_green", "paint_blue", "lacquer_red", "timber_dark")
 
 
+def random_lighting(rng: np.random.Generator) -> Lighting:
+    """A sun and sky drawn for a procedural building (the `random:SEED` and `family:SEED` families)."""
+    return Lighting(
+        sun_azimuth_deg=float(rng.uniform(0, 360)),
+        sun_elevation_deg=float(rng.uniform(25, 70)),
+        sun_irradiance=float(rng.uniform(2.0, 3.8)),
+        sky_radiance=tuple(float(c) for c in rng.uniform(0.45, 0.75, 3)),
+    )
+
+
 def random_spec(seed: int) -> BuildingSpec:
     """A building drawn from the grammar by `seed` (footprint, storeys, roof, details, finishes, light)."""
     rng = np.random.default_rng([seed, 0x5CE7E])
@@ -271,12 +281,7 @@ def random_spec(seed: int) -> BuildingSpec:
             shutters=Finish(pick(_PAINT)),
             trim=Finish(pick(_WALLS)),
         ),
-        lighting=Lighting(
-            sun_azimuth_deg=float(rng.uniform(0, 360)),
-            sun_elevation_deg=float(rng.uniform(25, 70)),
-            sun_irradiance=float(rng.uniform(2.0, 3.8)),
-            sky_radiance=tuple(float(c) for c in rng.uniform(0.45, 0.75, 3)),
-        ),
+        lighting=random_lighting(rng),
         ground=Finish(pick(("grass", "gravel", "forest_floor"))),
     )
     if footprint == "tower":

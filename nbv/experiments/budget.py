@@ -30,7 +30,7 @@ from tyro.conf import arg
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import config_record, git_commit, run_cache
-from nbv.experiments.budget_flight import METRES, flight_markdown, flight_tables
+from nbv.experiments.budget_flight import METRES, flight_markdown, flight_tables, seed_rows
 from nbv.experiments.planner_study import PlannerStudy, StudyRun, run_study
 from nbv.experiments.sfm_columns import planned_sfm_table
 from nbv.fanout.config import ExecutorConfig
@@ -155,15 +155,7 @@ def budget_sfm(runs: list[StudyRun], config: BudgetConfig) -> str:
 def budget_rows(curves: dict[tuple[str, str], list[list[float]]], budgets: tuple[int, ...]) -> list[dict]:
     """Per building and planner, then per planner over all buildings ('mean'): coverage mean and std (over
     seeds, then over buildings' seed means) at each budget, and the AUC of the mean curve."""
-    rows = []
-    for (scene, planner), seeds in curves.items():
-        values = np.asarray(seeds)
-        rows.append({"scene": scene, "planner": planner, "mean": values.mean(0).tolist(),
-                     "std": values.std(0).tolist()})
-    for planner in dict.fromkeys(p for _, p in curves):
-        means = np.asarray([r["mean"] for r in rows if r["planner"] == planner])
-        rows.append({"scene": "mean", "planner": planner, "mean": means.mean(0).tolist(),
-                     "std": means.std(0).tolist()})
+    rows = seed_rows(curves)
     for row in rows:
         row["auc"] = coverage_auc(budgets, row["mean"])
     return rows

@@ -5,26 +5,12 @@ from __future__ import annotations
 
 import os
 import signal
-import subprocess
-import sys
 import time
-from pathlib import Path
 
 import pytest
+from lock_holder import hold
 
 from common.locks import OutputBusy, claim, lock_file, release
-
-ROOT = Path(__file__).resolve().parents[2]
-
-
-def hold(out: Path, seconds: float = 60.0) -> subprocess.Popen:
-    """Another process holding the lock of `out` for `seconds` (it has it once this returns)."""
-    code = (f"import time; from common.locks import claim; claim({str(out)!r}); print('held', flush=True); "
-            f"time.sleep({seconds})")
-    child = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
-                             env={**os.environ, "PYTHONPATH": str(ROOT)})
-    assert child.stdout.readline().strip() == "held"
-    return child
 
 
 def test_second_writer_fails_at_once_naming_the_holders_pid_and_sigkill_frees_it(tmp_path):

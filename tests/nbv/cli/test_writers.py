@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 import torch
 import trimesh
+from lock_holder import hold
 from PIL import Image
 from synthetic import write_circle_dataset
 
@@ -43,16 +44,6 @@ def one_line(capsys: pytest.CaptureFixture) -> str:
 def leftovers(out: Path) -> list[str]:
     """What runs leave beside `out`: temporary folders, set-aside outputs, lock files."""
     return sorted(p.name for p in out.parent.iterdir() if p.name.startswith(f".{out.name}."))
-
-
-def hold(out: Path, seconds: float = 60.0) -> subprocess.Popen:
-    """Another process holding the lock of `out` (as a run writing it does) for `seconds`."""
-    code = (f"import time; from common.locks import claim; claim({str(out)!r}); print('held', flush=True); "
-            f"time.sleep({seconds})")
-    child = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
-                             env={**os.environ, "PYTHONPATH": str(ROOT)})
-    assert child.stdout.readline().strip() == "held"
-    return child
 
 
 @pytest.fixture(scope="module")

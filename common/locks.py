@@ -13,7 +13,7 @@ import fcntl
 import os
 import time
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 
 WAIT = [False]
@@ -57,11 +57,9 @@ def _acquire(target: Path, wait: bool) -> int:
         except FileNotFoundError:
             current = False
         if current:  # else its holder removed it on release between our open and our lock
-            try:
+            with suppress(OSError):  # a full disk: the lock holds without the pid ("pid unknown")
                 os.ftruncate(fd, 0)
                 os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
-            except OSError:
-                pass  # a full disk: the lock holds without the pid (a refused run says "pid unknown")
             return fd
         os.close(fd)
 
@@ -93,10 +91,9 @@ def remove_if_free(path: str | Path) -> None:
     except OSError:
         return
     try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        Path(path).unlink(missing_ok=True)
-    except OSError:
-        pass  # held: its run is alive
+        with suppress(OSError):  # held: its run is alive, and its lock file stays
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            Path(path).unlink(missing_ok=True)
     finally:
         os.close(fd)
 

@@ -7,7 +7,8 @@ import os
 from pathlib import Path
 
 NAME_ROOM = 32
-"""Bytes an output's name leaves free for the names written beside it (`.NAME.tmp-PID-XXXXXXXX`)."""
+"""Bytes an output's name leaves free for the names written beside it (its temporary folder is
+`.NAME.tmp-PID-` and eight random characters)."""
 
 
 def check_out_path(out: str | Path) -> None:

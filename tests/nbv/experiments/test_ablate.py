@@ -63,10 +63,16 @@ def test_an_unknown_axis_is_refused_by_name():
     assert run.returncode == 2 and "fog" in run.stderr
 
 
+SMALLER = ["--width", "64", "--height", "48", "--quality-views", "1", "--reference-spp", "64",
+           "--greedy-views", "3", "--greedy-candidates", "2", "--metric-points", "3000"]
+"""`--quick` made smaller still (every axis and level, each stage run; fewer pixels, views and samples):
+the CI suite's time goes on the stages, not their size."""
+
+
 @pytest.mark.slow
 def test_quick_ablation_end_to_end(tmp_path):
-    run = subprocess.run([sys.executable, "-m", "nbv.cli", "ablate", "--quick", "--out", str(tmp_path)],
-                         capture_output=True, text=True, timeout=540)
+    run = subprocess.run([sys.executable, "-m", "nbv.cli", "ablate", "--quick", "--out", str(tmp_path),
+                          *SMALLER], capture_output=True, text=True, timeout=540)
     assert run.returncode == 0, run.stderr[-2000:]
     doc = json.loads((tmp_path / "ablations.json").read_text())
     rows = {(r["axis"], r["level"]): r for r in doc["rows"]}
@@ -74,7 +80,7 @@ def test_quick_ablation_end_to_end(tmp_path):
     with open(tmp_path / "ablations.csv") as handle:
         assert len(list(csv.DictReader(handle))) == len(rows)
     spp = [rows[("spp", label)]["psnr_db_mean"] for label in ("1", "4", "16", "64")]
-    assert spp == sorted(spp)  # more samples, closer to the high-spp reference
+    assert all(a < b for a, b in zip(spp, spp[1:])), spp  # more samples, closer to the high-spp reference
     assert all(r["jaccard_mean"] == 1.0 for r in doc["rows"] if r["reference"])
     lighting = [r for r in doc["rows"] if AXES[r["axis"]].lighting]
     assert all(r["greedy_coverage_mean"] is not None for r in lighting)

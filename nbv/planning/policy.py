@@ -41,7 +41,7 @@ class PolicyPlanner(Planner):
     def __init__(self, checkpoint: str | Path, sample: bool = False, seed: int = 0,
                  blank_images: bool = False) -> None:
         self.sample, self.seed, self.checkpoint = sample, seed, checkpoint
-        self.blank_images = blank_images  # an evaluation-time test: every image it captures replaced by a blank
+        self.blank_images = blank_images  # an evaluation-time test: every captured image replaced by a blank
         config, weights = load_policy(checkpoint)
         try:
             self.env_config = config_from_record(EnvConfig, config["env"])

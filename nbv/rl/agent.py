@@ -104,7 +104,8 @@ class CriticNet(nn.Module):
             nn.Flatten(),
         )
         conv_out = _conv_out_features(self.observation, (1, history, obs_size, obs_size))
-        self.observation_fc = nn.Sequential(nn.Linear(conv_out + extra, h), nn.ReLU(), nn.Linear(h, h), nn.ReLU())
+        self.observation_fc = nn.Sequential(nn.Linear(conv_out + extra, h), nn.ReLU(), nn.Linear(h, h),
+                                            nn.ReLU())
         self.location = nn.Sequential(
             nn.Linear(3 * history + 3, config.location_hidden), nn.ReLU(),
             nn.Linear(config.location_hidden, h), nn.ReLU())

@@ -1,4 +1,4 @@
-"""What the Bag of Views has seen, as a vector beside the frames (`EnvConfig.bov_observation`, beyond the paper).
+"""What the Bag of Views has seen, a vector beside the frames (`EnvConfig.bov_observation`, beyond the paper).
 
 The paper's state is the last `history` frames and viewpoints: a policy that sees only those cannot tell
 which sides of the building the episode has already covered once they leave the history, so it learns

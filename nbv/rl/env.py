@@ -188,7 +188,7 @@ class NBVEnv(EnvBase):
         self._resume_pending = False
         self._view: Viewpoint | None = None
         self._return = torch.zeros(1)  # the episode's return so far (float32, summed as `RewardSum` does)
-        self._novelty, self._metres = 0.0, 0.0  # the last view's novelty and the metres flown (bov_observation)
+        self._novelty, self._metres = 0.0, 0.0  # the last view's novelty, the metres flown (bov_observation)
         self._set_seed(seed)
 
     # -- TorchRL hooks -------------------------------------------------------------------------

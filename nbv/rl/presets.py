@@ -84,7 +84,8 @@ def default_preset() -> TrainConfig:
 def looks_preset() -> TrainConfig:
     """The default with the Bag of Views observation, trained on the family buildings too."""
     default = default_preset()
-    env = replace(default.env, scenes=SceneSet(scene=TRAIN_SCENES + FAMILY_TRAIN_SCENES), bov_observation=True)
+    scenes = SceneSet(scene=TRAIN_SCENES + FAMILY_TRAIN_SCENES)
+    env = replace(default.env, scenes=scenes, bov_observation=True)
     validation = replace(default.validation, validation_scenes=VALIDATION_SCENES + FAMILY_VALIDATION_SCENES)
     return replace(default, env=env, validation=validation)
 

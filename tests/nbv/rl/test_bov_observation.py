@@ -32,8 +32,9 @@ ACTIONS = ([0.0, 1.0, 0.0], [0.5, -0.4, 0.6])
 
 def config(**kwargs) -> EnvConfig:
     settings = dict(scenes=SceneSet(scene=("test_building",)), camera=UAVCamera(64, 48),
-                    render=RenderSettings(spp=1), bov=BoVConfig(ranges=4, words=5, sift=FeatureConfig(
-                        backend="opencv")), obs_size=16, max_steps=5, action_mode="relative", relative_step=0.125)
+                    render=RenderSettings(spp=1),
+                    bov=BoVConfig(ranges=4, words=5, sift=FeatureConfig(backend="opencv")), obs_size=16,
+                    max_steps=5, action_mode="relative", relative_step=0.125)
     return EnvConfig(**{**settings, **kwargs})
 
 
@@ -72,7 +73,8 @@ def test_on_it_adds_only_the_vector_and_the_networks_read_it():
     assert rewards == off_rewards and [v.as_array().tolist() for v in views] == [
         v.as_array().tolist() for v in off_views]
     for off, state in zip(off_states, states):
-        assert torch.equal(off["pixels"], state["pixels"]) and torch.equal(off["viewpoints"], state["viewpoints"])
+        assert torch.equal(off["pixels"], state["pixels"])
+        assert torch.equal(off["viewpoints"], state["viewpoints"])
         assert state[BOV_KEY].shape == (bov_observation_size(on.config),) == (2 * 4 + 3,)
     words, cap = on.bov.word_count.double() / 5, on.bov.memory_count.double() / on.bov.memory_cap
     expected = torch.cat([words, cap, torch.tensor([0.0, 3 / 6, 0.0])]).float()

@@ -71,9 +71,11 @@ class Scorer:
         loaded = world.target
         if (scene, seed) not in self._visibility:
             self._visibility[scene, seed] = scene_visibility(loaded, config.camera, seed=seed)
-        coverage = self._visibility[scene, seed].coverage([viewpoint_to_c2w(v, loaded.center()) for v in chosen])
+        poses = [viewpoint_to_c2w(v, loaded.center()) for v in chosen]
+        coverage = self._visibility[scene, seed].coverage(poses)
         return {"coverage": 100.0 * coverage, "flight_m": flight_record(world.start, chosen)["flight_m"],
-                "viewpoints": [v.as_array().tolist() for v in chosen], "start": world.start.as_array().tolist()}
+                "viewpoints": [v.as_array().tolist() for v in chosen],
+                "start": world.start.as_array().tolist()}
 
 
 def spread_m(runs: dict[tuple[str, int], dict], scenes: list[str], seeds: list[int]) -> float:
@@ -94,13 +96,15 @@ def evaluate(planners: dict[str, tuple[Planner, bool]], trained: EnvConfig, scen
         env = planner.env_config if is_policy else trained
         runs = {(s, seed): scorer.fly(planner, env, s, seed)
                 for s, seed in tqdm(list(itertools.product(scenes, seeds)), desc=name, unit="run")}
-        summary = {"coverage": {s: float(np.mean([runs[s, seed]["coverage"] for seed in seeds])) for s in scenes},
-                   "flight_m": {s: float(np.mean([runs[s, seed]["flight_m"] for seed in seeds])) for s in scenes},
+        def mean(key: str, got: dict) -> dict[str, float]:
+            return {s: float(np.mean([got[s, seed][key] for seed in seeds])) for s in scenes}
+
+        summary = {"coverage": mean("coverage", runs), "flight_m": mean("flight_m", runs),
                    "spread_m": spread_m(runs, scenes, seeds)}
         if is_policy:
             blank = PolicyPlanner(planner.checkpoint, blank_images=True)
-            summary["blank"] = {s: float(np.mean([scorer.fly(blank, env, s, seed)["coverage"] for seed in seeds]))
-                                for s in scenes}
+            summary["blank"] = mean("coverage", {(s, seed): scorer.fly(blank, env, s, seed)
+                                                 for s, seed in itertools.product(scenes, seeds)})
         results[name] = {"summary": summary,
                          "runs": {f"{s}/seed{seed}": run for (s, seed), run in runs.items()}}
     return results
@@ -124,9 +128,9 @@ def report(results: dict, scenes: list[str], seeds: list[int], views: int, refer
     head = ["planner", "coverage %", f"vs {reference}", f"worst vs {reference}", "metres", "spread m",
             "blank drop", *scenes]
     return (f"Visible-surface coverage (%) of the true mesh at {views} views, mean over start views "
-            f"{', '.join(map(str, seeds))}, on validation buildings; metres along the viewing shell; spread: mean "
-            "distance between camera positions on two buildings from the same start; blank drop: coverage "
-            "lost with blank images.\n\n" + markdown_table(head, rows))
+            f"{', '.join(map(str, seeds))}, on validation buildings; metres along the viewing shell; spread: "
+            "mean distance between camera positions on two buildings from the same start; blank drop: "
+            "coverage lost with blank images.\n\n" + markdown_table(head, rows))
 
 
 def main() -> None:
@@ -140,7 +144,8 @@ def main() -> None:
     args = parser.parse_args()
     refused = [s for s in args.scenes if held_out(s)]
     if refused:
-        raise SystemExit(f"held-out buildings are not for choosing: {', '.join(refused)}; give validation ones")
+        raise SystemExit(f"held-out buildings are not for choosing: {', '.join(refused)}; give validation "
+                         "ones")
     policies = {name: PolicyPlanner(path) for name, path in (p.split("=", 1) for p in args.policy)}
     trained = next(iter(policies.values())).env_config
     planners = {name: (p, True) for name, p in policies.items()}
@@ -148,14 +153,15 @@ def main() -> None:
     results = evaluate(planners, trained, args.scenes, args.seeds, args.views)
     table = report(results, args.scenes, args.seeds, args.views, args.baselines[0] if args.baselines else
                    next(iter(policies)))
-    with atomic_folder(args.out, overwrite=True, outputs=("results.json", "results.md", "coverage.png")) as out:
+    outputs = ("results.json", "results.md", "coverage.png")
+    with atomic_folder(args.out, overwrite=True, outputs=outputs) as out:
         write_text(out / "results.md", table)
         plot_seed_scores({n: list(d["summary"]["coverage"].values()) for n, d in results.items()},
                          out / "coverage.png", "visible coverage % (validation buildings)",
                          "13 views: policies vs the tuned orbit")
-        write_json(out / "results.json", {"commit": git_commit(), "scenes": args.scenes, "seeds": args.seeds,
-                                          "views": args.views, "policies": dict(p.split("=", 1) for p in args.policy),
-                                          "results": results, "command": sys.argv})
+        write_json(out / "results.json", {
+            "commit": git_commit(), "scenes": args.scenes, "seeds": args.seeds, "views": args.views,
+            "policies": dict(p.split("=", 1) for p in args.policy), "results": results, "command": sys.argv})
     print(table)
 
 

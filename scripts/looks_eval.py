@@ -47,7 +47,7 @@ from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes.family_splits import held_out
 from scenes.spec import SceneSet
 
-SCENES = (*VALIDATION_SCENES, *FAMILY_VALIDATION_SCENES, "family:14", "family:29")
+SCENES = (*VALIDATION_SCENES, *FAMILY_VALIDATION_SCENES, "family:9", "family:14", "family:29")
 """The validation buildings scored: the default's three, and four validation-split family buildings (a
 tower, a courtyard, a U plan, a hall)."""
 

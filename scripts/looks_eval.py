@@ -15,13 +15,14 @@ For each policy (`--policy NAME=PATH`, a `policy.pt`) and baseline planner (`--b
 Validation buildings only: the script refuses held-out ones (`scenes.family_splits.held_out`).
 
     python scripts/looks_eval.py --policy default=RUNS/default/policy.pt --policy looks=RUNS/looks/policy.pt \
-        --out paper_results/selection/round5
+        --out paper_results/selection/round5 --work RUNS/looks_eval
 """
 
 from __future__ import annotations
 
 import argparse
 import itertools
+import json
 import sys
 from pathlib import Path
 
@@ -88,25 +89,38 @@ def spread_m(runs: dict[tuple[str, int], dict], scenes: list[str], seeds: list[i
     return float(np.mean(gaps))
 
 
+def score_planner(scorer: Scorer, planner: Planner, env: EnvConfig, scenes: list[str], seeds: list[int],
+                  blank: Planner | None) -> dict:
+    """One planner's runs and summary (coverage, metres, spread; with `blank`, its blank-image coverage)."""
+    pairs = list(itertools.product(scenes, seeds))
+    runs = {(s, seed): scorer.fly(planner, env, s, seed) for s, seed in tqdm(pairs, unit="run")}
+
+    def mean(key: str, got: dict) -> dict[str, float]:
+        return {s: float(np.mean([got[s, seed][key] for seed in seeds])) for s in scenes}
+
+    summary = {"coverage": mean("coverage", runs), "flight_m": mean("flight_m", runs),
+               "spread_m": spread_m(runs, scenes, seeds)}
+    if blank is not None:
+        summary["blank"] = mean("coverage", {pair: scorer.fly(blank, env, *pair) for pair in pairs})
+    return {"summary": summary, "runs": {f"{s}/seed{seed}": run for (s, seed), run in runs.items()}}
+
+
 def evaluate(planners: dict[str, tuple[Planner, bool]], trained: EnvConfig, scenes: list[str],
-             seeds: list[int], views: int) -> dict:
-    """Every planner's runs and summary (coverage, metres, spread; a policy's blank-image coverage)."""
+             seeds: list[int], views: int, work: Path) -> dict:
+    """Every planner's `score_planner`, each kept in `work/NAME.json` and reused while its key holds."""
     scorer, results = Scorer(trained, views), {}
     for name, (planner, is_policy) in planners.items():
+        checkpoint = Path(planner.checkpoint) if is_policy else None
+        key = {"scenes": scenes, "seeds": seeds, "views": views, "checkpoint": str(checkpoint),
+               "mtime": checkpoint.stat().st_mtime if checkpoint else None}
+        saved = work / f"{name}.json"
+        if saved.is_file() and json.loads(saved.read_text())["key"] == key:
+            results[name] = json.loads(saved.read_text())["result"]
+            continue
         env = planner.env_config if is_policy else trained
-        runs = {(s, seed): scorer.fly(planner, env, s, seed)
-                for s, seed in tqdm(list(itertools.product(scenes, seeds)), desc=name, unit="run")}
-        def mean(key: str, got: dict) -> dict[str, float]:
-            return {s: float(np.mean([got[s, seed][key] for seed in seeds])) for s in scenes}
-
-        summary = {"coverage": mean("coverage", runs), "flight_m": mean("flight_m", runs),
-                   "spread_m": spread_m(runs, scenes, seeds)}
-        if is_policy:
-            blank = PolicyPlanner(planner.checkpoint, blank_images=True)
-            summary["blank"] = mean("coverage", {(s, seed): scorer.fly(blank, env, s, seed)
-                                                 for s, seed in itertools.product(scenes, seeds)})
-        results[name] = {"summary": summary,
-                         "runs": {f"{s}/seed{seed}": run for (s, seed), run in runs.items()}}
+        blank = PolicyPlanner(checkpoint, blank_images=True) if is_policy else None
+        results[name] = score_planner(scorer, planner, env, scenes, seeds, blank)
+        write_json(saved, {"key": key, "result": results[name]})
     return results
 
 
@@ -141,6 +155,7 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
     parser.add_argument("--views", type=int, default=13)
     parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--work", type=Path, required=True, help="per-planner results, reused when re-run")
     args = parser.parse_args()
     refused = [s for s in args.scenes if held_out(s)]
     if refused:
@@ -150,7 +165,8 @@ def main() -> None:
     trained = next(iter(policies.values())).env_config
     planners = {name: (p, True) for name, p in policies.items()}
     planners |= {name: (make_planner(name, PlanSettings(), seed=0), False) for name in args.baselines}
-    results = evaluate(planners, trained, args.scenes, args.seeds, args.views)
+    args.work.mkdir(parents=True, exist_ok=True)
+    results = evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work)
     table = report(results, args.scenes, args.seeds, args.views, args.baselines[0] if args.baselines else
                    next(iter(policies)))
     outputs = ("results.json", "results.md", "coverage.png")

@@ -89,38 +89,48 @@ def spread_m(runs: dict[tuple[str, int], dict], scenes: list[str], seeds: list[i
     return float(np.mean(gaps))
 
 
-def score_planner(scorer: Scorer, planner: Planner, env: EnvConfig, scenes: list[str], seeds: list[int],
-                  blank: Planner | None) -> dict:
-    """One planner's runs and summary (coverage, metres, spread; with `blank`, its blank-image coverage)."""
-    pairs = list(itertools.product(scenes, seeds))
-    runs = {(s, seed): scorer.fly(planner, env, s, seed) for s, seed in tqdm(pairs, unit="run")}
+def score_scene(scorer: Scorer, planner: Planner, env: EnvConfig, scene: str, seeds: list[int],
+                blank: Planner | None) -> dict:
+    """One planner's runs on one building (and with `blank`, its blank-image coverage), by seed."""
+    runs = {str(seed): scorer.fly(planner, env, scene, seed) for seed in tqdm(seeds, desc=scene, unit="run")}
+    blanks = {str(seed): scorer.fly(blank, env, scene, seed)["coverage"] for seed in seeds} if blank else {}
+    return {"runs": runs, "blank": blanks}
 
-    def mean(key: str, got: dict) -> dict[str, float]:
-        return {s: float(np.mean([got[s, seed][key] for seed in seeds])) for s in scenes}
 
-    summary = {"coverage": mean("coverage", runs), "flight_m": mean("flight_m", runs),
+def summarise(by_scene: dict[str, dict], scenes: list[str], seeds: list[int]) -> dict:
+    """A planner's summary: per building, mean coverage, metres (and blank coverage); the spread."""
+    def mean(value) -> dict[str, float]:
+        return {s: float(np.mean([value(by_scene[s], str(seed)) for seed in seeds])) for s in scenes}
+
+    runs = {(s, seed): by_scene[s]["runs"][str(seed)] for s in scenes for seed in seeds}
+    summary = {"coverage": mean(lambda doc, seed: doc["runs"][seed]["coverage"]),
+               "flight_m": mean(lambda doc, seed: doc["runs"][seed]["flight_m"]),
                "spread_m": spread_m(runs, scenes, seeds)}
-    if blank is not None:
-        summary["blank"] = mean("coverage", {pair: scorer.fly(blank, env, *pair) for pair in pairs})
-    return {"summary": summary, "runs": {f"{s}/seed{seed}": run for (s, seed), run in runs.items()}}
+    if by_scene[scenes[0]]["blank"]:
+        summary["blank"] = mean(lambda doc, seed: doc["blank"][seed])
+    return summary
 
 
 def evaluate(planners: dict[str, tuple[Planner, bool]], trained: EnvConfig, scenes: list[str],
              seeds: list[int], views: int, work: Path) -> dict:
-    """Every planner's `score_planner`, each kept in `work/NAME.json` and reused while its key holds."""
+    """Every planner's runs and summary; each (planner, building) kept in `work/NAME/SCENE.json` and reused
+    while its key holds (so buildings can be scored by processes side by side, then gathered)."""
     scorer, results = Scorer(trained, views), {}
     for name, (planner, is_policy) in planners.items():
         checkpoint = Path(planner.checkpoint) if is_policy else None
-        key = {"scenes": scenes, "seeds": seeds, "views": views, "checkpoint": str(checkpoint),
+        key = {"seeds": seeds, "views": views, "checkpoint": str(checkpoint),
                "mtime": checkpoint.stat().st_mtime if checkpoint else None}
-        saved = work / f"{name}.json"
-        if saved.is_file() and json.loads(saved.read_text())["key"] == key:
-            results[name] = json.loads(saved.read_text())["result"]
-            continue
         env = planner.env_config if is_policy else trained
         blank = PolicyPlanner(checkpoint, blank_images=True) if is_policy else None
-        results[name] = score_planner(scorer, planner, env, scenes, seeds, blank)
-        write_json(saved, {"key": key, "result": results[name]})
+        by_scene = {}
+        for scene in scenes:
+            saved = work / name / f"{scene.replace(':', '_')}.json"
+            if saved.is_file() and json.loads(saved.read_text())["key"] == key:
+                by_scene[scene] = json.loads(saved.read_text())["result"]
+                continue
+            by_scene[scene] = score_scene(scorer, planner, env, scene, seeds, blank)
+            write_json(saved, {"key": key, "result": by_scene[scene]})
+        results[name] = {"summary": summarise(by_scene, scenes, seeds), "runs": by_scene}
     return results
 
 

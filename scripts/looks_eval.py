@@ -129,6 +129,7 @@ def evaluate(planners: dict[str, tuple[Planner, bool]], trained: EnvConfig, scen
                 by_scene[scene] = json.loads(saved.read_text())["result"]
                 continue
             by_scene[scene] = score_scene(scorer, planner, env, scene, seeds, blank)
+            saved.parent.mkdir(parents=True, exist_ok=True)
             write_json(saved, {"key": key, "result": by_scene[scene]})
         results[name] = {"summary": summarise(by_scene, scenes, seeds), "runs": by_scene}
     return results

@@ -278,8 +278,8 @@ class ValidationConfig:
 
 @dataclass(frozen=True)
 class RewardConfig:
-    """Training-only reward terms, beyond the paper, added to the Bag of Views reward. They read the true
-    mesh, so only the training env gets them (`nbv.rl.builders.make_environment`); an `NBVEnv` built
+    """Training-only reward terms, beyond the paper, added to the Bag of Views reward. The coverage term reads
+    the true mesh, so only the training env gets them (`nbv.rl.builders.make_environment`); an `NBVEnv` built
     from an `EnvConfig` alone (planning, validation, scoring) has none."""
 
     coverage: Annotated[float, arg(name="coverage-reward")] = 0.0

@@ -116,14 +116,16 @@ def run(quick: bool) -> list[BenchResult]:
     results = []
     updates = sac_updates_per_s(config, 5 if quick else 50)
     results.append(BenchResult("rl", "SAC updates/s, batch 8, 64x64 frames", updates, "updates/s"))
-    for backend in ("kornia", "opencv"):
+    for backend, observed in (("kornia", False), ("opencv", False), ("opencv", True)):
         sift = replace(config.bov.sift, backend=backend)
-        stages = planning_ms(replace(config, bov=replace(config.bov, sift=sift)), 3 if quick else 12)
+        label = f"{backend} SIFT" + (", BoV observation" if observed else "")
+        stages = planning_ms(replace(config, bov=replace(config.bov, sift=sift), bov_observation=observed),
+                             3 if quick else 12)
         for stage, ms in stages.items():
-            results.append(BenchResult("rl", f"planning {stage} ms/step ({backend} SIFT)", ms, "ms"))
+            results.append(BenchResult("rl", f"planning {stage} ms/step ({label})", ms, "ms"))
         total = sum(stages.values())
         met = "met" if total <= GOAL_PLANNING_MS else "NOT met"
-        name = f"planning ms/step without rendering ({backend} SIFT + BoV + policy)"
+        name = f"planning ms/step without rendering ({label} + BoV + policy)"
         results.append(BenchResult("rl", name, total, "ms", f"<= {GOAL_PLANNING_MS:g}: {met}"))
     results.extend(lattice_vs_render(config, steps))
     # ParallelEnv throughput last: after in-process renders and a ParallelEnv, torch ops in this process

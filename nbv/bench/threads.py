@@ -35,6 +35,7 @@ from nbv.bov.bag import BagOfViews
 from nbv.features.sift import FeatureConfig, extract_features
 from nbv.features.source import gray_frame
 from nbv.rl.agent import make_actor
+from nbv.rl.bov_observation import BOV_KEY, bov_observation_size, bov_vector, novelty_of
 from nbv.rl.config import EnvConfig
 from render.camera import UAVCamera
 from scenes import DEFAULT_SCENE
@@ -110,9 +111,11 @@ def planning_step_ms(images: np.ndarray, config: EnvConfig, repeats: int) -> dic
     """Mean ms per view of features, BoV reward and actor forward, from the best of `repeats` passes.
 
     Each pass steps through every view in turn (azimuth 0.7 rad apart) with a fresh Bag of Views, which
-    fills up as in an episode; one untimed pass first warms up the actor, the extractor and the BoV.
+    fills up as in an episode; one untimed pass first warms up the actor, the extractor and the BoV. With
+    `config.bov_observation` the Bag of Views stage also builds the state's `bov` vector, which the actor
+    reads.
     """
-    actor = make_actor(config.history, config.obs_size)
+    actor = make_actor(config.history, config.obs_size, extra=bov_observation_size(config))
     features = config.bov.feature_config()
     tau, side = config.history, config.obs_size
     td = TensorDict({"pixels": torch.zeros(tau, side, side, dtype=torch.uint8),
@@ -126,7 +129,10 @@ def planning_step_ms(images: np.ndarray, config: EnvConfig, repeats: int) -> dic
                 t0 = time.perf_counter()
                 descriptors = extract_features([rgb], features)[0].descriptors
                 t1 = time.perf_counter()
-                bov.reward(descriptors, 0.7 * i)
+                reward = bov.reward(descriptors, 0.7 * i)
+                if config.bov_observation:
+                    vector = bov_vector(bov, novelty_of(reward, bov), i + 1, 0.5 * i, config)
+                    td[BOV_KEY] = torch.from_numpy(vector)
                 t2 = time.perf_counter()
                 td["pixels"] = torch.cat([td["pixels"][1:], torch.from_numpy(gray_frame(rgb, side))[None]])
                 actor(td)

@@ -38,7 +38,8 @@ def parse_train(args: Sequence[str], prog: str = "nbv train") -> TrainConfig:
         # --scene appends: given scenes replace the preset's instead of joining them
         preset = replace(preset, env=replace(preset.env, scenes=SceneSet(scene=tyro.MISSING)))
     description = (f"Soft Actor-Critic on the NBV env, preset {name!r} (--preset {{{','.join(PRESETS)}}}: "
-                   "the validated default or the paper's Table 1; every flag overrides the preset).")
+                   "the validated default, the paper's Table 1, or the issue-26 candidate with the Bag of "
+                   "Views observation and the family buildings; every flag overrides the preset).")
     return parse(TrainConfig, rest, prog, default=preset, description=description)
 
 

@@ -16,6 +16,7 @@ from common.provenance import config_from_record
 from nbv.planning.base import Planner
 from nbv.planning.registry import SHIPPED_POLICY
 from nbv.rl.agent import make_actor
+from nbv.rl.bov_observation import bov_observation_size
 from nbv.rl.checkpoint import CheckpointError, load_policy
 from nbv.rl.config import EnvConfig, NetworkConfig
 from nbv.rl.env import NBVEnv
@@ -37,13 +38,16 @@ class PolicyPlanner(Planner):
 
     name = "policy"
 
-    def __init__(self, checkpoint: str | Path, sample: bool = False, seed: int = 0) -> None:
+    def __init__(self, checkpoint: str | Path, sample: bool = False, seed: int = 0,
+                 blank_images: bool = False) -> None:
         self.sample, self.seed, self.checkpoint = sample, seed, checkpoint
+        self.blank_images = blank_images  # an evaluation-time test: every captured image replaced by a blank
         config, weights = load_policy(checkpoint)
         try:
             self.env_config = config_from_record(EnvConfig, config["env"])
             network = config_from_record(NetworkConfig, config["network"])
-            self.actor = make_actor(self.env_config.history, self.env_config.obs_size, network)
+            self.actor = make_actor(self.env_config.history, self.env_config.obs_size, network,
+                                    bov_observation_size(self.env_config))
         except (KeyError, TypeError, ValueError, AttributeError, RuntimeError) as err:
             raise CheckpointError(f"checkpoint {checkpoint}: its config does not fit this toolkit: "
                                   f"{type(err).__name__}: {err}") from err
@@ -73,7 +77,10 @@ class PolicyPlanner(Planner):
         """Act until the episode ends (one pass or the step cap), or for exactly `views` views, in an env
         on the world's settings and view source (the env draws the world's start view)."""
         self.check_env(world.env)
-        env = NBVEnv(world.env, seed=world.seed, source=world.source)
+        config = world.env
+        if config.bov_observation and views is not None and 2 <= views <= config.max_steps + 1:
+            config = replace(config, episode_views=views)  # its views-left entry counts down this budget
+        env = NBVEnv(config, seed=world.seed, source=world.source, blank_images=self.blank_images)
         try:
             return policy_views(self.actor, env, views, self.sample, self.seed)
         except ValueError as err:  # e.g. a NaN action from finite but diverged weights: name the file

@@ -15,6 +15,10 @@ the locations and the action through fully connected layers of 64 and 128;
 the two fused through fully connected layers of 128 and then ONE output.
 The paper's critic ends in 3 outputs ("the output quality value vector");
 SAC's soft Q-function is a scalar per state-action pair, so ours ends in 1.
+
+With `extra` > 0 (`EnvConfig.bov_observation`, beyond the paper) both also read the state's `bov`
+vector (..., extra), concatenated to the flattened convolution output before its first fully connected
+layer. With `extra` = 0 the networks, their parameters and their initial draws are the paper's.
 """
 
 from __future__ import annotations
@@ -50,7 +54,8 @@ class ActorNet(nn.Module):
         - output: loc (*, 3), scale (*, 3)
     """
 
-    def __init__(self, history: int, obs_size: int, config: NetworkConfig = NetworkConfig()) -> None:
+    def __init__(self, history: int, obs_size: int, config: NetworkConfig = NetworkConfig(),
+                 extra: int = 0) -> None:
         super().__init__()
         c, h = config.channels, config.hidden
         self.observation = nn.Sequential(
@@ -60,16 +65,17 @@ class ActorNet(nn.Module):
             nn.Flatten(),
         )
         conv_out = _conv_out_features(self.observation, (history, obs_size, obs_size))
-        self.observation_fc = nn.Sequential(nn.Linear(conv_out, h), nn.ReLU())
+        self.observation_fc = nn.Sequential(nn.Linear(conv_out + extra, h), nn.ReLU())
         self.location = nn.Sequential(
             nn.Linear(3 * history, config.location_hidden), nn.ReLU(),
             nn.Linear(config.location_hidden, h), nn.ReLU())
         self.head = nn.Sequential(nn.Linear(2 * h, h), nn.ReLU(), nn.Linear(h, 6), NormalParamExtractor())
 
-    def forward(self, pixels: torch.Tensor, viewpoints: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    def forward(self, pixels: torch.Tensor, viewpoints: torch.Tensor,
+                bov: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
         frames, batch = _flatten_batch(pixels.float() / 255.0, 3)
         locations, _ = _flatten_batch(viewpoints, 2)
-        features = torch.cat([self.observation_fc(self.observation(frames)),
+        features = torch.cat([self.observation_fc(_with_extra(self.observation(frames), bov)),
                               self.location(locations.flatten(1))], dim=-1)
         loc, scale = self.head(features)
         return loc.reshape(*batch, 3), scale.reshape(*batch, 3)
@@ -83,7 +89,8 @@ class CriticNet(nn.Module):
         - output: (*, 1)
     """
 
-    def __init__(self, history: int, obs_size: int, config: NetworkConfig = NetworkConfig()) -> None:
+    def __init__(self, history: int, obs_size: int, config: NetworkConfig = NetworkConfig(),
+                 extra: int = 0) -> None:
         super().__init__()
         c, h = config.channels // 2, config.hidden
         depth_kernel = min(3, history)
@@ -97,24 +104,37 @@ class CriticNet(nn.Module):
             nn.Flatten(),
         )
         conv_out = _conv_out_features(self.observation, (1, history, obs_size, obs_size))
-        self.observation_fc = nn.Sequential(nn.Linear(conv_out, h), nn.ReLU(), nn.Linear(h, h), nn.ReLU())
+        self.observation_fc = nn.Sequential(nn.Linear(conv_out + extra, h), nn.ReLU(), nn.Linear(h, h),
+                                            nn.ReLU())
         self.location = nn.Sequential(
             nn.Linear(3 * history + 3, config.location_hidden), nn.ReLU(),
             nn.Linear(config.location_hidden, h), nn.ReLU())
         self.head = nn.Sequential(nn.Linear(2 * h, h), nn.ReLU(), nn.Linear(h, 1))
 
-    def forward(self, pixels: torch.Tensor, viewpoints: torch.Tensor, action: torch.Tensor) -> torch.Tensor:
+    def forward(self, pixels: torch.Tensor, viewpoints: torch.Tensor, action: torch.Tensor,
+                bov: torch.Tensor | None = None) -> torch.Tensor:
         frames, batch = _flatten_batch(pixels.float() / 255.0, 3)
         locations, _ = _flatten_batch(viewpoints, 2)
         actions, _ = _flatten_batch(action, 1)
-        encoded = self.observation_fc(self.observation(frames.unsqueeze(1)))
+        encoded = self.observation_fc(_with_extra(self.observation(frames.unsqueeze(1)), bov))
         located = self.location(torch.cat([locations.flatten(1), actions], dim=-1))
         return self.head(torch.cat([encoded, located], dim=-1)).reshape(*batch, 1)
 
 
-def make_actor(history: int, obs_size: int, config: NetworkConfig = NetworkConfig()) -> ProbabilisticActor:
-    """The stochastic policy: `pixels`, `viewpoints` -> `action` in [-1, 1]^3 (TanhNormal)."""
-    net = TensorDictModule(ActorNet(history, obs_size, config), in_keys=["pixels", "viewpoints"],
+def _with_extra(encoded: torch.Tensor, extra: torch.Tensor | None) -> torch.Tensor:
+    """The flattened convolution output, with the `bov` vector (flattened like it) after it if given."""
+    return encoded if extra is None else torch.cat([encoded, _flatten_batch(extra, 1)[0]], dim=-1)
+
+
+def _keys(extra: int) -> list[str]:
+    return ["pixels", "viewpoints"] + (["bov"] if extra else [])
+
+
+def make_actor(history: int, obs_size: int, config: NetworkConfig = NetworkConfig(),
+               extra: int = 0) -> ProbabilisticActor:
+    """The stochastic policy: `pixels`, `viewpoints` (and `bov` when `extra` > 0) -> `action` in [-1, 1]^3
+    (TanhNormal)."""
+    net = TensorDictModule(ActorNet(history, obs_size, config, extra), in_keys=_keys(extra),
                            out_keys=["loc", "scale"])
     return ProbabilisticActor(
         net, in_keys=["loc", "scale"], spec=Bounded(-1.0, 1.0, shape=(3,)),
@@ -122,6 +142,9 @@ def make_actor(history: int, obs_size: int, config: NetworkConfig = NetworkConfi
         return_log_prob=False, default_interaction_type="random")
 
 
-def make_critic(history: int, obs_size: int, config: NetworkConfig = NetworkConfig()) -> ValueOperator:
-    """One Q network: `pixels`, `viewpoints`, `action` -> `state_action_value`; SACLoss makes the twin."""
-    return ValueOperator(CriticNet(history, obs_size, config), in_keys=["pixels", "viewpoints", "action"])
+def make_critic(history: int, obs_size: int, config: NetworkConfig = NetworkConfig(),
+                extra: int = 0) -> ValueOperator:
+    """One Q network: `pixels`, `viewpoints`, `action` (and `bov` when `extra` > 0) -> `state_action_value`;
+    SACLoss makes the twin."""
+    return ValueOperator(CriticNet(history, obs_size, config, extra),
+                         in_keys=["pixels", "viewpoints", "action"] + (["bov"] if extra else []))

@@ -19,6 +19,7 @@ from torchrl.objectives import SACLoss, SoftUpdate
 
 from nbv.fanout.worker import cap_threads
 from nbv.rl.agent import make_actor, make_critic
+from nbv.rl.bov_observation import bov_observation_size
 from nbv.rl.config import (
     CollectorConfig,
     EnvConfig,
@@ -77,7 +78,9 @@ def training_env(config: EnvConfig, index: int, seed: int, reward_terms: RewardC
 
 def make_sac_agent(env: EnvConfig, network: NetworkConfig) -> tuple[ProbabilisticActor, ValueOperator]:
     """The actor and one critic (SACLoss clones it into the twin Q networks)."""
-    return make_actor(env.history, env.obs_size, network), make_critic(env.history, env.obs_size, network)
+    extra = bov_observation_size(env)
+    return (make_actor(env.history, env.obs_size, network, extra),
+            make_critic(env.history, env.obs_size, network, extra))
 
 
 def make_loss_module(actor: ProbabilisticActor, critic: ValueOperator,

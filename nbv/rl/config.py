@@ -89,6 +89,11 @@ class EnvConfig:
     relative_step: float = 0.25
     """Relative and orbit modes: the largest step per action, as a fraction of each range (azimuth: of
     2 pi)."""
+    bov_observation: bool = False
+    """Beyond the paper: add to the state a vector of what the Bag of Views has seen (key `bov`,
+    `nbv.rl.bov_observation`): each vocabulary's word and descriptor fill, the last view's novelty, the
+    views left and the metres flown. It reads only the captured images and the poses flown. Off: the
+    paper's state (frames and viewpoints), bit-for-bit."""
 
     def __post_init__(self) -> None:
         if not 0 < self.radius_min <= self.radius_max:
@@ -273,8 +278,8 @@ class ValidationConfig:
 
 @dataclass(frozen=True)
 class RewardConfig:
-    """Training-only reward terms, beyond the paper, added to the Bag of Views reward. They read the true
-    mesh, so only the training env gets them (`nbv.rl.builders.make_environment`); an `NBVEnv` built
+    """Training-only reward terms, beyond the paper, added to the Bag of Views reward. The coverage term reads
+    the true mesh, so only the training env gets them (`nbv.rl.builders.make_environment`); an `NBVEnv` built
     from an `EnvConfig` alone (planning, validation, scoring) has none."""
 
     coverage: Annotated[float, arg(name="coverage-reward")] = 0.0
@@ -282,9 +287,15 @@ class RewardConfig:
     view is the first of its episode to see (ground truth, so training only). 0: the Bag of Views reward
     alone (the paper)."""
 
+    flight: Annotated[float, arg(name="flight-reward")] = 0.0
+    """Weight W of a flight-cost term: minus W x the metres of the leg to the new view along the viewing
+    shell (`nbv.flight.shell_path`), beyond the paper. 0: no flight cost."""
+
     def __post_init__(self) -> None:
         if not 0 <= self.coverage < math.inf:
             raise ValueError(f"coverage_reward must be finite and >= 0, got {self.coverage}")
+        if not 0 <= self.flight < math.inf:
+            raise ValueError(f"flight_reward must be finite and >= 0, got {self.flight}")
 
 
 @dataclass(frozen=True)

@@ -70,7 +70,9 @@ from common.threads import apply_thread_policy
 from nbv.bov.bag import BagOfViews
 from nbv.features.sift import FeatureConfig
 from nbv.features.source import ViewSource
+from nbv.flight.path import shell_path
 from nbv.recon.visibility import SurfaceVisibility, scene_visibility
+from nbv.rl.bov_observation import BOV_KEY, bov_observation_size, bov_vector, novelty_of
 from nbv.rl.config import EnvConfig, RewardConfig
 from nbv.rl.episode_return import RETURN_KEY
 from nbv.rl.lattice import ViewLattice, build_lattice
@@ -139,6 +141,8 @@ class NBVEnv(EnvBase):
             none, so an env built from an `EnvConfig` alone never reads the true mesh.
         source: the view source to render with (shared with a planner); default: a new one on the
             config's camera, render, feature and frame settings.
+        blank_images: replace every captured image by a blank one (a black frame, no descriptors): an
+            evaluation-time test of how much the policy's choices depend on what it sees.
 
     Example:
         >>> from render.camera import UAVCamera
@@ -149,15 +153,20 @@ class NBVEnv(EnvBase):
     """
 
     def __init__(self, config: EnvConfig, worker: int = 0, seed: int = 0,
-                 reward_terms: RewardConfig = RewardConfig(), source: ViewSource | None = None) -> None:
+                 reward_terms: RewardConfig = RewardConfig(), source: ViewSource | None = None,
+                 blank_images: bool = False) -> None:
         super().__init__(device="cpu", batch_size=torch.Size([]))
         self.config = config
         self.reward_terms = reward_terms
         self.worker = worker
+        self.blank_images = blank_images
         tau, side = config.history, config.obs_size
+        extra = {BOV_KEY: Unbounded(shape=(bov_observation_size(config),), dtype=torch.float32)
+                 } if config.bov_observation else {}
         self.observation_spec = Composite(
             pixels=Bounded(0, 255, shape=(tau, side, side), dtype=torch.uint8),
             viewpoints=Bounded(-1.0, 1.0, shape=(tau, 3), dtype=torch.float32),
+            **extra,
         )
         self.action_spec = Bounded(-1.0, 1.0, shape=(3,), dtype=torch.float32)
         self.reward_spec = Unbounded(shape=(1,), dtype=torch.float32)
@@ -179,6 +188,7 @@ class NBVEnv(EnvBase):
         self._resume_pending = False
         self._view: Viewpoint | None = None
         self._return = torch.zeros(1)  # the episode's return so far (float32, summed as `RewardSum` does)
+        self._novelty, self._metres = 0.0, 0.0  # the last view's novelty, the metres flown (bov_observation)
         self._set_seed(seed)
 
     # -- TorchRL hooks -------------------------------------------------------------------------
@@ -202,7 +212,12 @@ class NBVEnv(EnvBase):
         self._view = draw_viewpoint(low, high, self._rng)
         self.bov.reset()
         frame, descriptors = self.capture(self._view)
-        self.bov.update(descriptors, self._view.azimuth, self._view.elevation)
+        if self.config.bov_observation:  # the same update, its novelty kept
+            self._novelty = novelty_of(self.bov.reward(descriptors, self._view.azimuth, self._view.elevation),
+                                       self.bov)
+        else:
+            self.bov.update(descriptors, self._view.azimuth, self._view.elevation)
+        self._metres = 0.0
         if self.reward_terms.coverage:
             self._seen = self.surface_seen(self._view).copy()  # ours to grow: the node's cache stays as is
         location = normalise_viewpoint(self._view, self.config)
@@ -216,11 +231,16 @@ class NBVEnv(EnvBase):
     def _step(self, tensordict: TensorDictBase) -> TensorDictBase:
         view = action_to_viewpoint(tensordict["action"], self._view, self.config)
         frame, descriptors = self.capture(view)
-        reward = self.bov.reward(descriptors, view.azimuth, view.elevation)
+        reward = bov_reward = self.bov.reward(descriptors, view.azimuth, view.elevation)
         if self.reward_terms.coverage:
             seen = self.surface_seen(view)
             reward += self.reward_terms.coverage * float((seen & ~self._seen).mean())
             self._seen |= seen
+        if self.reward_terms.flight or self.config.bov_observation:
+            leg_m = shell_path(self._view, [view]).total_m
+            self._metres += leg_m
+            self._novelty = novelty_of(bov_reward, self.bov)
+            reward -= self.reward_terms.flight * leg_m
         self._progress += wrap_angle(view.azimuth - self._view.azimuth)
         self._view = view
         self._steps += 1
@@ -296,6 +316,7 @@ class NBVEnv(EnvBase):
             "progress": self._progress, "steps": self._steps, "bov": self.bov.state_dict(),
             "episode_return": self._return.clone(),
             **({"seen": torch.from_numpy(self._seen.copy())} if self._seen is not None else {}),
+            **({"novelty": self._novelty, "metres": self._metres} if self.config.bov_observation else {}),
         }
 
     def restore(self, state: dict[str, Any]) -> None:
@@ -311,6 +332,7 @@ class NBVEnv(EnvBase):
         self._return = state.get("episode_return", torch.zeros(1)).clone()  # older snapshots: restarts at 0
         self.bov.load_state_dict(state["bov"])
         self._seen = state["seen"].numpy().copy() if "seen" in state else None
+        self._novelty, self._metres = float(state.get("novelty", 0.0)), float(state.get("metres", 0.0))
         self._resume_pending = True
 
     # -- rendering -----------------------------------------------------------------------------
@@ -330,6 +352,9 @@ class NBVEnv(EnvBase):
         Rendered, or with a lattice read from the cache at the nearest node.
         """
         apply_thread_policy()  # here, not in __init__: in the process that steps the env
+        if self.blank_images:
+            side = self.config.obs_size
+            return np.zeros((side, side), dtype=np.uint8), torch.zeros(0, 128)
         if self.config.lattice.enabled:
             lattice = self._lattice(self._scene)
             return lattice.observe(lattice.snap(view)[1])
@@ -360,9 +385,12 @@ class NBVEnv(EnvBase):
         return self._lattices[spec.scene]
 
     def _observation(self, terminated: bool = False, truncated: bool = False) -> TensorDict:
+        extra = {BOV_KEY: torch.from_numpy(bov_vector(self.bov, self._novelty, self._steps + 1, self._metres,
+                                                      self.config))} if self.config.bov_observation else {}
         return TensorDict({
             "pixels": torch.from_numpy(self._frames.copy()),
             "viewpoints": torch.from_numpy(self._locations.astype(np.float32)),
+            **extra,
             "done": torch.tensor([terminated or truncated]),
             "terminated": torch.tensor([terminated]),
             "truncated": torch.tensor([truncated]),

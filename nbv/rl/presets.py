@@ -8,6 +8,9 @@
   (the evaluation's budget) instead of one pass, 6000 frames, every 250 frames the actor
   scored on the validation buildings, trained on `TRAIN_SCENES`; 3 members (training seeds,
   3 local workers) and the best-validated actor of them all kept as `policy.pt`.
+- `looks`: a candidate, not chosen yet (issue 26, paper_results/selection/round5): the default with the
+  Bag of Views observation (`EnvConfig.bov_observation`) and the family buildings: `FAMILY_TRAIN_SCENES`
+  added to the training buildings and `FAMILY_VALIDATION_SCENES` to the validation buildings.
 - `paper`: the paper's Table 1 to the letter (absolute actions, fixed alpha 0.2, raw
   rewards, azimuth-only Bag of Views ranges, the Bag of Views reward alone, every view
   rendered): the config classes' own defaults.
@@ -49,6 +52,12 @@ VALIDATION_SCENES = ("random:6", "random:7", "random:8")
 COVERAGE_REWARD = 100.0
 """The default's weight of the reward's coverage term (round 4 of paper_results/selection: 100 and 300
 against none, then 100 over nine seeds)."""
+FAMILY_TRAIN_SCENES = ("family:1", "family:2", "family:7", "family:8")
+"""Training-split `family:SEED` buildings of four seen traits: a tower, a courtyard, an arcade and a hall
+(`scenes.family_splits`; the compound trait and SEED % 5 == 0 are held out). Four, not one per trait, for
+the view lattices' cost on 2 cores: the ones whose best orbit differs most (paper_results/family)."""
+FAMILY_VALIDATION_SCENES = ("family:4",)
+"""A validation-split `family:SEED` building (SEED % 5 == 4), a tower: one, for the lattice's cost."""
 MEMBERS = 3
 """Training seeds of one default command, side by side (three 6000-frame runs took 11-15 min on 2 cores)."""
 
@@ -73,5 +82,14 @@ def default_preset() -> TrainConfig:
                    members=MembersConfig(count=MEMBERS), executor=ExecutorConfig(workers=MEMBERS))
 
 
-PRESETS = {"default": default_preset, "paper": paper_preset}
+def looks_preset() -> TrainConfig:
+    """The default with the Bag of Views observation, trained on the family buildings too."""
+    default = default_preset()
+    scenes = SceneSet(scene=TRAIN_SCENES + FAMILY_TRAIN_SCENES)
+    env = replace(default.env, scenes=scenes, bov_observation=True)
+    validation = replace(default.validation, validation_scenes=VALIDATION_SCENES + FAMILY_VALIDATION_SCENES)
+    return replace(default, env=env, validation=validation)
+
+
+PRESETS = {"default": default_preset, "paper": paper_preset, "looks": looks_preset}
 """`nbv train --preset NAME`."""

@@ -23,6 +23,7 @@ import torch
 
 from nbv.recon.visibility import SurfaceVisibility, scene_visibility
 from nbv.rl.agent import make_actor
+from nbv.rl.bov_observation import bov_observation_size
 from nbv.rl.config import EnvConfig, LatticeConfig, NetworkConfig, ValidationConfig
 from nbv.rl.env import NBVEnv
 from nbv.rl.rollout import policy_views
@@ -60,7 +61,7 @@ class LatticeValidator:
         self.validation = validation
         self.config = validation_env_config(env, validation)
         with torch.random.fork_rng():  # its initial weights are overwritten: draw none of training's numbers
-            self.actor = make_actor(env.history, env.obs_size, network)
+            self.actor = make_actor(env.history, env.obs_size, network, bov_observation_size(env))
         self.actor.eval()
         self._envs: dict[str, NBVEnv] = {}
         self._visibility: dict[str, SurfaceVisibility] = {}

@@ -1,0 +1,196 @@
+"""Does a policy look? Trained candidates against the tuned orbit on validation buildings (issue 26, round 5).
+
+For each policy (`--policy NAME=PATH`, a `policy.pt`) and baseline planner (`--baselines`, default the tuned
+`orbit` and `random`), on each validation building and start view (seed), 13 views by default:
+
+- coverage: the share of the true surface the views see (`nbv.recon.visibility`, samples seeded by the
+  seed; the model-selection score of `nbv.planning.selection`), exact renders at the policy's settings;
+- metres: the flight from the start view through the views along the viewing shell (`flight_record`);
+- blank: a policy's coverage with every captured image replaced by a blank one (`blank_images`): a
+  policy that looks loses coverage;
+- spread: from the same start view, the mean distance (metres, positions relative to each building's
+  centre) between the i-th camera positions on two different buildings, over every pair and seed: an
+  open-loop policy flies the same path everywhere (0 m).
+
+Validation buildings only: the script refuses held-out ones (`scenes.family_splits.held_out`).
+
+    python scripts/looks_eval.py --policy default=RUNS/default/policy.pt --policy looks=RUNS/looks/policy.pt \
+        --out paper_results/selection/round5 --work RUNS/looks_eval
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from common.io import atomic_folder, markdown_table, write_json, write_text
+from common.provenance import git_commit
+from nbv.features.source import ViewSource
+from nbv.flight.path import shell_position
+from nbv.flight.record import flight_record
+from nbv.planning.base import Planner
+from nbv.planning.config import PlanSettings
+from nbv.planning.policy import PolicyPlanner
+from nbv.planning.registry import make_planner
+from nbv.planning.world import PlanningWorld
+from nbv.recon.visibility import SurfaceVisibility, scene_visibility
+from nbv.rl.config import EnvConfig
+from nbv.rl.presets import FAMILY_VALIDATION_SCENES, VALIDATION_SCENES
+from nbv.rl.validate import evaluation_env_config
+from nbv.viz.figures import plot_seed_scores
+from render.viewpoint import Viewpoint, viewpoint_to_c2w
+from scenes.family_splits import held_out
+from scenes.spec import SceneSet
+
+SCENES = (*VALIDATION_SCENES, *FAMILY_VALIDATION_SCENES, "family:9", "family:14", "family:29")
+"""The validation buildings scored: the default's three, and four validation-split family buildings (a
+tower, a courtyard, a U plan, a hall)."""
+
+
+class Scorer:
+    """Flies planners on one settings' validation buildings, one view source and visibility per building."""
+
+    def __init__(self, env: EnvConfig, views: int) -> None:
+        self.env, self.views = env, views
+        self._sources: dict[str, ViewSource] = {}
+        self._visibility: dict[tuple[str, int], SurfaceVisibility] = {}
+
+    def fly(self, planner: Planner, trained: EnvConfig, scene: str, seed: int) -> dict:
+        """The planner's views on `scene` from seed `seed`'s start: coverage (%), metres, positions."""
+        config = evaluation_env_config(trained, SceneSet(scene=(scene,)))
+        if scene not in self._sources:
+            self._sources[scene] = ViewSource(config.camera, config.render, config.bov.feature_config(),
+                                              config.obs_size, seed)
+        world = PlanningWorld(config, seed=seed, source=self._sources[scene])
+        chosen = planner.plan(world, self.views)
+        loaded = world.target
+        if (scene, seed) not in self._visibility:
+            self._visibility[scene, seed] = scene_visibility(loaded, config.camera, seed=seed)
+        poses = [viewpoint_to_c2w(v, loaded.center()) for v in chosen]
+        coverage = self._visibility[scene, seed].coverage(poses)
+        return {"coverage": 100.0 * coverage, "flight_m": flight_record(world.start, chosen)["flight_m"],
+                "viewpoints": [v.as_array().tolist() for v in chosen],
+                "start": world.start.as_array().tolist()}
+
+
+def spread_m(runs: dict[tuple[str, int], dict], scenes: list[str], seeds: list[int]) -> float:
+    """Mean distance between the i-th camera positions on two buildings from the same start, metres."""
+    gaps = []
+    for seed, (a, b) in itertools.product(seeds, itertools.combinations(scenes, 2)):
+        pa = [shell_position(*Viewpoint(*v).as_array()) for v in runs[a, seed]["viewpoints"]]
+        pb = [shell_position(*Viewpoint(*v).as_array()) for v in runs[b, seed]["viewpoints"]]
+        gaps.append(float(np.mean([np.linalg.norm(x - y) for x, y in zip(pa, pb)])))
+    return float(np.mean(gaps))
+
+
+def score_scene(scorer: Scorer, planner: Planner, env: EnvConfig, scene: str, seeds: list[int],
+                blank: Planner | None) -> dict:
+    """One planner's runs on one building (and with `blank`, its blank-image coverage), by seed."""
+    runs = {str(seed): scorer.fly(planner, env, scene, seed) for seed in tqdm(seeds, desc=scene, unit="run")}
+    blanks = {str(seed): scorer.fly(blank, env, scene, seed)["coverage"] for seed in seeds} if blank else {}
+    return {"runs": runs, "blank": blanks}
+
+
+def summarise(by_scene: dict[str, dict], scenes: list[str], seeds: list[int]) -> dict:
+    """A planner's summary: per building, mean coverage, metres (and blank coverage); the spread."""
+    def mean(value) -> dict[str, float]:
+        return {s: float(np.mean([value(by_scene[s], str(seed)) for seed in seeds])) for s in scenes}
+
+    runs = {(s, seed): by_scene[s]["runs"][str(seed)] for s in scenes for seed in seeds}
+    summary = {"coverage": mean(lambda doc, seed: doc["runs"][seed]["coverage"]),
+               "flight_m": mean(lambda doc, seed: doc["runs"][seed]["flight_m"]),
+               "spread_m": spread_m(runs, scenes, seeds)}
+    if by_scene[scenes[0]]["blank"]:
+        summary["blank"] = mean(lambda doc, seed: doc["blank"][seed])
+    return summary
+
+
+def evaluate(planners: dict[str, tuple[Planner, bool]], trained: EnvConfig, scenes: list[str],
+             seeds: list[int], views: int, work: Path) -> dict:
+    """Every planner's runs and summary; each (planner, building) kept in `work/NAME/SCENE.json` and reused
+    while its key holds (so buildings can be scored by processes side by side, then gathered)."""
+    scorer, results = Scorer(trained, views), {}
+    for name, (planner, is_policy) in planners.items():
+        checkpoint = Path(planner.checkpoint) if is_policy else None
+        key = {"seeds": seeds, "views": views, "checkpoint": str(checkpoint),
+               "mtime": checkpoint.stat().st_mtime if checkpoint else None}
+        env = planner.env_config if is_policy else trained
+        blank = PolicyPlanner(checkpoint, blank_images=True) if is_policy else None
+        by_scene = {}
+        for scene in scenes:
+            saved = work / name / f"{scene.replace(':', '_')}.json"
+            if saved.is_file() and json.loads(saved.read_text())["key"] == key:
+                by_scene[scene] = json.loads(saved.read_text())["result"]
+                continue
+            by_scene[scene] = score_scene(scorer, planner, env, scene, seeds, blank)
+            saved.parent.mkdir(parents=True, exist_ok=True)
+            write_json(saved, {"key": key, "result": by_scene[scene]})
+        results[name] = {"summary": summarise(by_scene, scenes, seeds), "runs": by_scene}
+    return results
+
+
+def report(results: dict, scenes: list[str], seeds: list[int], views: int, reference: str) -> str:
+    """The results table (markdown): per planner, mean coverage, its gap to `reference`, metres, the looks
+    figures, and each building's coverage."""
+    ref = results[reference]["summary"]["coverage"]
+    rows = []
+    for name, doc in results.items():
+        summary = doc["summary"]
+        cov = summary["coverage"]
+        mean = float(np.mean(list(cov.values())))
+        blank = summary.get("blank")
+        drop = f"{mean - float(np.mean(list(blank.values()))):.1f}" if blank else "-"
+        rows.append([name, f"{mean:.1f}", f"{mean - float(np.mean(list(ref.values()))):+.1f}",
+                     f"{min(cov[s] - ref[s] for s in scenes):+.1f}",
+                     f"{np.mean(list(summary['flight_m'].values())):.1f}", f"{summary['spread_m']:.2f}", drop,
+                     *(f"{cov[s]:.1f}" for s in scenes)])
+    head = ["planner", "coverage %", f"vs {reference}", f"worst vs {reference}", "metres", "spread m",
+            "blank drop", *scenes]
+    return (f"Visible-surface coverage (%) of the true mesh at {views} views, mean over start views "
+            f"{', '.join(map(str, seeds))}, on validation buildings; metres along the viewing shell; spread: "
+            "mean distance between camera positions on two buildings from the same start; blank drop: "
+            "coverage lost with blank images.\n\n" + markdown_table(head, rows))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--policy", action="append", default=[], metavar="NAME=PATH", required=True)
+    parser.add_argument("--baselines", nargs="*", default=["orbit", "random"])
+    parser.add_argument("--scenes", nargs="+", default=list(SCENES))
+    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    parser.add_argument("--views", type=int, default=13)
+    parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--work", type=Path, required=True, help="per-planner results, reused when re-run")
+    args = parser.parse_args()
+    refused = [s for s in args.scenes if held_out(s)]
+    if refused:
+        raise SystemExit(f"held-out buildings are not for choosing: {', '.join(refused)}; give validation "
+                         "ones")
+    policies = {name: PolicyPlanner(path) for name, path in (p.split("=", 1) for p in args.policy)}
+    trained = next(iter(policies.values())).env_config
+    planners = {name: (p, True) for name, p in policies.items()}
+    planners |= {name: (make_planner(name, PlanSettings(), seed=0), False) for name in args.baselines}
+    args.work.mkdir(parents=True, exist_ok=True)
+    results = evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work)
+    table = report(results, args.scenes, args.seeds, args.views, args.baselines[0] if args.baselines else
+                   next(iter(policies)))
+    outputs = ("results.json", "results.md", "coverage.png")
+    with atomic_folder(args.out, overwrite=True, outputs=outputs) as out:
+        write_text(out / "results.md", table)
+        plot_seed_scores({n: list(d["summary"]["coverage"].values()) for n, d in results.items()},
+                         out / "coverage.png", "visible coverage % (validation buildings)",
+                         "13 views: policies vs the tuned orbit")
+        write_json(out / "results.json", {
+            "commit": git_commit(), "scenes": args.scenes, "seeds": args.seeds, "views": args.views,
+            "policies": dict(p.split("=", 1) for p in args.policy), "results": results, "command": sys.argv})
+    print(table)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -20,8 +20,8 @@ import cv2
 import kornia
 import torch
 
+from common.cache import write_cache
 from common.io import cache_dir as cache_root
-from common.io import write_cache
 from nbv.features.sift import DESCRIPTOR_DIM, FeatureConfig, Features, extract_features
 from render.dataset import ViewDataset
 from render.dataset_read import image_bytes

@@ -27,7 +27,8 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from common.io import atomic_path, cache_dir
+from common.cache import write_cache
+from common.io import cache_dir
 from nbv.fanout.task import Task
 from nbv.features.sift import FeatureConfig, extract_features
 from nbv.features.source import gray_frame
@@ -123,9 +124,8 @@ def build_lattice(scene: Scene, make_renderer: Callable[[], MitsubaRenderer], co
     counts = torch.tensor([len(d) for d in descriptors], dtype=torch.long)
     stacked = torch.from_numpy(np.stack(frames))
     flat = torch.cat(descriptors) if descriptors else torch.zeros(0, 128)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        torch.save({"frames": stacked, "counts": counts, "descriptors": flat.half()}, tmp)
+    doc = {"frames": stacked, "counts": counts, "descriptors": flat.half()}
+    write_cache(path, lambda tmp: torch.save(doc, tmp))  # locked; if it fails: a warning, rendered next time
     return ViewLattice(stacked.numpy(), counts.numpy(), flat.half().float(), axes)
 
 

@@ -1,9 +1,9 @@
 """Writing cache entries: one writer per entry (its lock, `common.locks`), and a failing write only warns.
 
 A cache saves time, nothing more: where an entry cannot be written (a full disk, a read-only cache
-folder, a quota), the command warns in one line naming the entry and the errno, and goes on with the
-value it computed. The entries that are files handed on by path (textures) are written into a
-temporary folder of this run instead, removed when it exits.
+folder, a quota), the command warns in one line naming the entry and the errno (once per cache folder),
+and goes on with the value it computed. The entries that are files handed on by path (textures) are
+written into a temporary folder of this run instead, removed when it exits.
 """
 
 from __future__ import annotations
@@ -22,10 +22,16 @@ from common.locks import OutputBusy, claim, release
 
 _SCRATCH: list[Path] = []
 """This run's temporary folder for the files the cache could not keep (made on first need)."""
+_WARNED: set[Path] = set()
+"""The cache folders a failing write was reported for: one warning per folder, not one per entry."""
 
 
 def warn_not_written(path: Path, err: BaseException) -> None:
-    """Warn, in one line, that the cache entry `path` was not written and why (`describe`: the errno)."""
+    """Warn, in one line, that the cache entry `path` was not written and why (`describe`: the errno); once
+    per cache folder (a full disk fails every entry alike)."""
+    if path.parent in _WARNED:
+        return
+    _WARNED.add(path.parent)
     if isinstance(err, OSError):
         same = err.filename is not None and Path(os.fsdecode(err.filename)) == path
         why = describe(OSError(err.errno, err.strerror) if same and err.errno else err)  # name `path` once

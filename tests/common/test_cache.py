@@ -55,8 +55,9 @@ def test_a_full_disk_under_a_file_entry_warns_once_and_hands_on_a_temporary_copy
         copy = cache_file(entry, write)
     assert len(caught) == 1 and copy.read_text() == "texels" and cache not in copy.parents
     with warnings.catch_warnings():
-        warnings.simplefilter("error")  # warned once: the copy is used from now on
+        warnings.simplefilter("error")  # warned once: the copy is used now, the folder not reported again
         assert cache_file(entry, write) == copy
+        assert cache_file(entry.with_name("b.txt"), write).read_text() == "texels"
     assert sorted(p.name for p in entry.parent.iterdir()) == []  # nothing partial left in the cache
 
 

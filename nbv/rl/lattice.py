@@ -17,6 +17,7 @@ actors included) then only read the cache.
 from __future__ import annotations
 
 import hashlib
+import io
 import json
 import math
 from collections.abc import Callable
@@ -124,8 +125,9 @@ def build_lattice(scene: Scene, make_renderer: Callable[[], MitsubaRenderer], co
     counts = torch.tensor([len(d) for d in descriptors], dtype=torch.long)
     stacked = torch.from_numpy(np.stack(frames))
     flat = torch.cat(descriptors) if descriptors else torch.zeros(0, 128)
-    doc = {"frames": stacked, "counts": counts, "descriptors": flat.half()}
-    write_cache(path, lambda tmp: torch.save(doc, tmp))  # locked; if it fails: a warning, rendered next time
+    buffer = io.BytesIO()  # saved in memory first: torch.save hides a full disk's errno in a RuntimeError
+    torch.save({"frames": stacked, "counts": counts, "descriptors": flat.half()}, buffer)
+    write_cache(path, lambda tmp: tmp.write_bytes(buffer.getbuffer()))  # locked; if it fails: a warning
     return ViewLattice(stacked.numpy(), counts.numpy(), flat.half().float(), axes)
 
 

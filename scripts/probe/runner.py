@@ -10,6 +10,7 @@ result), lost-partial, hang-memory. Settings are the report's: 64x48 at 1 spp, D
 
     PYTHONPATH=. python scripts/reliability_probe.py --scratch /tmp/probe --out paper_results/reliability
     PYTHONPATH=. python scripts/reliability_probe.py --only F3,F24   # some cases only
+    PYTHONPATH=. python scripts/reliability_probe.py --parts 3 --update   # re-run part 3 into OUT's results
 
 prints the counts per part and writes OUT/probe.json and OUT/probe.md (per case: part, id, command, outcome,
 last printed line) with the commit it ran at.
@@ -105,7 +106,8 @@ def print_table(table: dict) -> None:
         print(f"{part:<6}" + "".join(f"{table[part][c]:>14}" for c in cols))
 
 
-def main(argv: list[str] | None = None) -> int:
+def options(argv: list[str] | None) -> argparse.Namespace:
+    """The command line."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scratch", type=Path, default=Path("/tmp/reliability-probe"))
     parser.add_argument("--out", type=Path, default=ROOT / "paper_results/reliability")
@@ -113,7 +115,44 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--parts", default="", help="comma-separated part numbers")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--timeout-factor", type=float, default=1.0, help="scale every case's timeout")
-    args = parser.parse_args(argv)
+    parser.add_argument("--update", action="store_true",
+                        help="keep OUT/probe.json's records of the cases not run now (re-running some)")
+    return parser.parse_args(argv)
+
+
+def git_state() -> tuple[str, bool]:
+    """The checkout's short commit, and whether its tree is dirty."""
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                            text=True).stdout.strip()
+    dirty = subprocess.run(["git", "status", "--porcelain"], cwd=ROOT, capture_output=True, text=True)
+    return commit, bool(dirty.stdout.strip())
+
+
+def write_results(out: Path, records: list[dict], commit: str, dirty: bool, command: str,
+                  update: bool) -> dict:
+    """OUT/probe.json and OUT/probe.md (with `update`, merged into the records already there: each record
+    names the commit it ran at); the counts per part."""
+    commands = [command]
+    for record in records:
+        record["commit"] = commit + ("+dirty" if dirty else "")
+    if update and (out / "probe.json").is_file():
+        old = json.loads((out / "probe.json").read_text())
+        fresh = {r["id"] for r in records}
+        kept = [{"commit": old["commit"], **r} for r in old["cases"] if r["id"] not in fresh]
+        records, commands = kept + records, [*old.get("commands", [old["command"]]), command]
+    table = counts(records)
+    out.mkdir(parents=True, exist_ok=True)
+    doc = {"commit": commit, "dirty_tree": dirty, "command": command, "commands": commands, "counts": table,
+           "cases": records}
+    (out / "probe.json").write_text(json.dumps(doc, indent=1) + "\n")
+    (out / "probe.md").write_text(markdown(table, records, commit + (" (dirty)" if dirty else ""),
+                                           "`, then `".join(commands)))
+    return table
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the selected cases, print the counts per part and write OUT/probe.json and OUT/probe.md."""
+    args = options(argv)
     args.scratch = args.scratch.resolve()
     args.scratch.mkdir(parents=True, exist_ok=True)
     ENV.update(environment(args.scratch))
@@ -125,30 +164,11 @@ def main(argv: list[str] | None = None) -> int:
         case.timeout = int(case.timeout * args.timeout_factor)
     if args.parts:
         cases = [c for c in cases if str(c.part) in args.parts.split(",")]
-    commit = subprocess.run(
-        ["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True
-    ).stdout.strip()
-    dirty = bool(
-        subprocess.run(
-            ["git", "status", "--porcelain"], cwd=ROOT, capture_output=True, text=True
-        ).stdout.strip()
-    )
+    commit, dirty = git_state()
     print(f"{len(cases)} cases at {commit}{' (dirty tree)' if dirty else ''}", flush=True)
     with ThreadPoolExecutor(max_workers=args.jobs) as pool:
         records = list(pool.map(lambda c: run_case(c, args.scratch), cases))
-    table = counts(records)
-    print_table(table)
     command = "PYTHONPATH=. nice -n 10 python scripts/reliability_probe.py " + " ".join(
         "SCRATCH" if Path(a).resolve() == args.scratch else a for a in (argv or sys.argv[1:]))
-    args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "probe.json").write_text(
-        json.dumps(
-            {"commit": commit, "dirty_tree": dirty, "command": command, "counts": table, "cases": records},
-            indent=1,
-        )
-        + "\n"
-    )
-    (args.out / "probe.md").write_text(
-        markdown(table, records, commit + (" (dirty)" if dirty else ""), command)
-    )
+    print_table(write_results(args.out, records, commit, dirty, command, args.update))
     return 0 if all(r["outcome"] == "passed" for r in records) else 1

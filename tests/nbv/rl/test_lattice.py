@@ -6,6 +6,7 @@ import errno
 import math
 import os
 import signal
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -180,8 +181,8 @@ def test_lattice_cache_entry_is_written_by_one_run_and_a_failing_write_only_warn
         holder.stdout.close()
     assert not path.exists()  # left to the run that holds it
     with monkeypatch.context() as full_disk:
-        full_disk.setattr("torch.save", lambda *a, **k: (_ for _ in ()).throw(ENOSPC))
-        with pytest.warns(UserWarning, match=rf"^cache {path} not written \(no space left on device"):
+        full_disk.setattr(Path, "write_bytes", lambda *a, **k: (_ for _ in ()).throw(ENOSPC))
+        with pytest.warns(UserWarning, match=rf"^cache {path} not written \(no space left on device \(ENO"):
             full = build()
     assert not path.exists()
     build()

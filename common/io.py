@@ -8,7 +8,7 @@ folders of a run that died are cleaned up by the next run writing that folder.
 One run writes an output at a time: its lock (`common.locks`) is held from the
 up-front check to the swap, and a run without overwrite never replaces an output
 that appeared meanwhile. An OSError while writing names the output's path, not the
-temporary one (`common.errors.WriteError`); a cache write that fails only warns.
+temporary one (`common.errors.WriteError`); a cache write that fails only warns (`common.cache`).
 """
 
 from __future__ import annotations
@@ -20,8 +20,7 @@ import os
 import re
 import shutil
 import tempfile
-import warnings
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, NoReturn
@@ -320,31 +319,6 @@ def _cache_root() -> Path:
 def in_cache(path: str | Path) -> bool:
     """Whether `path` lies in the cache root (`cache_dir`)."""
     return Path(os.path.realpath(_cache_root())) in Path(os.path.realpath(path)).parents
-
-
-def write_cache(path: str | Path, write: Callable[[Path], None]) -> bool:
-    """Write the cache file `path` atomically with `write(tmp)`, holding its lock; skipped when another run
-    is writing it. A failing write (a full disk) is only a warning: a cache saves time, nothing more.
-    Returns whether the entry was written."""
-    path = Path(path)
-    try:
-        claim(path, wait=False)
-    except OutputBusy:
-        return False  # another run writes this very entry
-    except OSError as err:
-        warnings.warn(f"cache {path} not written ({describe(err)}); going on without it", stacklevel=2)
-        return False
-    try:
-        with atomic_path(path) as tmp:
-            write(tmp)
-        return True
-    except Exception as err:  # noqa: BLE001 - torch.save reports a full disk as RuntimeError
-        why = describe(err) if isinstance(err, OSError) else f"{type(err).__name__}: {str(err).strip()}"
-        warnings.warn(f"cache {path} not written ({why.splitlines()[0] if why else ''}); going on without it",
-                      stacklevel=2)
-        return False
-    finally:
-        release(path)
 
 
 def markdown_table(header: Sequence[str], rows: Sequence[Sequence[Any]]) -> str:

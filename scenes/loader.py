@@ -25,7 +25,8 @@ import numpy as np
 import trimesh
 from PIL import Image
 
-from common.io import atomic_path, cache_dir
+from common.cache import cache_file
+from common.io import cache_dir
 from scenes.mesh_files import GuardedResolver, check_ply_counts, resolve_obj_indices, texture_failures
 from scenes.model import Material, Part, Scene, validate_arrays
 from scenes.normalise import make_ground, normalise_parts
@@ -170,7 +171,7 @@ def _material(mesh: trimesh.Trimesh, name: str) -> tuple[Material, np.ndarray | 
 
 
 def _save_texture(image: Image.Image, name: str) -> Path:
-    """Write a mesh's texture to the cache as an sRGB PNG named by its content hash."""
+    """Write a mesh's texture to the cache as an sRGB PNG named by its content hash (`common.cache`)."""
     buffer = io.BytesIO()
     try:
         image.convert("RGB").save(buffer, format="PNG")
@@ -178,11 +179,7 @@ def _save_texture(image: Image.Image, name: str) -> Path:
         raise ValueError(f"part {name!r}: cannot decode its texture ({type(err).__name__}: {err})") from err
     data = buffer.getvalue()
     path = cache_dir() / "mesh_textures" / f"{hashlib.sha1(data).hexdigest()}.png"
-    if not path.exists():
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with atomic_path(path) as tmp:
-            tmp.write_bytes(data)
-    return path
+    return cache_file(path, lambda tmp: tmp.write_bytes(data))
 
 
 def _check_mitsuba_xml(path: Path) -> None:

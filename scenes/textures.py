@@ -17,7 +17,8 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from common.io import atomic_path, cache_dir
+from common.cache import cache_file
+from common.io import cache_dir
 from scenes.noise import anisotropic_fbm, fbm, per_cell, to_uint8, voronoi
 
 TEXTURE_SIZE = 1024
@@ -294,11 +295,7 @@ def make_texture(name: str, seed: int, size: int = TEXTURE_SIZE) -> np.ndarray:
 
 
 def texture_path(name: str, seed: int, size: int = TEXTURE_SIZE) -> Path:
-    """The cached PNG of texture `name` for `seed`, generated and written atomically if missing."""
+    """The cached PNG of texture `name` for `seed`, generated and written if missing (`common.cache`: where
+    the cache cannot keep it, a warning and a copy in this run's temporary folder)."""
     path = cache_dir() / "textures" / f"{name}_s{seed}_{size}px_v{_VERSION}.png"
-    if not path.exists():
-        image = make_texture(name, seed, size)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with atomic_path(path) as tmp:
-            Image.fromarray(image).save(tmp)
-    return path
+    return cache_file(path, lambda tmp: Image.fromarray(make_texture(name, seed, size)).save(tmp))

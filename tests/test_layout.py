@@ -190,5 +190,5 @@ def long_functions(paths: list[Path]) -> list[str]:
 
 
 def test_no_function_is_over_60_lines():
-    long = long_functions(modules() + sorted((ROOT / "scripts").glob("*.py")))
+    long = long_functions(modules() + sorted((ROOT / "scripts").rglob("*.py")))
     assert long == [], "functions over 60 lines:\n" + "\n".join(long)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import importlib
 import os
 import sys
+import warnings
 from collections.abc import Sequence
 from typing import NamedTuple
 
@@ -111,6 +112,8 @@ def main(argv: list[str] | None = None) -> int:
     if name not in COMMANDS:
         print(f"nbv: error: unknown command {name!r} (choose from {', '.join(COMMANDS)})", file=sys.stderr)
         return 2
+    shown, warnings.formatwarning = warnings.formatwarning, lambda message, *_, **__: (
+        f"nbv {name}: warning: {message}\n")  # one line, without the source line Python adds
     WAIT[0] = WAIT_FLAG in rest
     rest = [arg for arg in rest if arg != WAIT_FLAG]
     try:
@@ -126,6 +129,8 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     except SystemExit as done:  # tyro's --help (0) and its messages about bad options (2)
         return 0 if done.code is None else done.code if isinstance(done.code, int) else 2
+    finally:
+        warnings.formatwarning = shown
 
 
 if __name__ == "__main__":

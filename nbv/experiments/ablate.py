@@ -37,6 +37,7 @@ import numpy as np
 from PIL import Image
 from tyro.conf import UseAppendAction
 
+from common.cache import write_cache
 from common.io import atomic_path, cache_dir, write_json
 from common.provenance import git_commit, run_cache
 from common.threads import apply_thread_policy
@@ -158,11 +159,11 @@ def _reference_views(config: AblateConfig, scene, viewpoints: list, picks: list[
         renderer = MitsubaRenderer(scene, config.camera, settings)
         poses = [viewpoint_to_c2w(viewpoints[i], renderer.center) for i in picks]
         pairs = [renderer.render(pose, seed=settings.view_seed(i)) for i, pose in zip(picks, poses)]
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with atomic_path(path) as tmp:
-            np.savez_compressed(tmp, rgb=np.stack([p[0] for p in pairs]),
-                                depth=np.stack([p[1] for p in pairs]), K=renderer.camera.K)
-    stored = np.load(path)
+        stored = {"rgb": np.stack([p[0] for p in pairs]), "depth": np.stack([p[1] for p in pairs]),
+                  "K": renderer.camera.K}
+        write_cache(path, lambda tmp: np.savez_compressed(tmp, **stored))  # if it fails: a warning
+    else:
+        stored = np.load(path)
     feats = extract_features(list(stored["rgb"]), config.bov.feature_config())
     return {"rgb": stored["rgb"], "depth": stored["depth"], "K": stored["K"], "features": feats}
 

@@ -11,6 +11,7 @@ does not load or does not match the dataset is rebuilt, never trusted.
 from __future__ import annotations
 
 import hashlib
+import io
 import json
 import warnings
 from collections.abc import Callable
@@ -20,8 +21,8 @@ import cv2
 import kornia
 import torch
 
+from common.cache import write_cache
 from common.io import cache_dir as cache_root
-from common.io import write_cache
 from nbv.features.sift import DESCRIPTOR_DIM, FeatureConfig, Features, extract_features
 from render.dataset import ViewDataset
 from render.dataset_read import image_bytes
@@ -100,7 +101,9 @@ def save_features(path: Path, feats: list[Features]) -> None:
         "descriptors": torch.cat([f.descriptors.cpu() for f in feats]).float(),
         "responses": torch.cat([f.responses.cpu() for f in feats]).float(),
     }
-    write_cache(path, lambda tmp: torch.save(doc, tmp))  # if it fails: a warning, extracted again next time
+    buffer = io.BytesIO()  # saved in memory first: torch.save hides a full disk's errno in a RuntimeError
+    torch.save(doc, buffer)
+    write_cache(path, lambda tmp: tmp.write_bytes(buffer.getbuffer()))  # if it fails: a warning
 
 
 def load_features(path: Path, views: int) -> list[Features]:

@@ -52,6 +52,10 @@ class PlanSettings:
     recon: ReconstructionConfig = ReconstructionConfig()
     """TSDF fusion of the captured views (and of the reference scan)."""
 
+    def __post_init__(self) -> None:
+        if self.candidates < 1:  # refused whichever planner runs, not only by those that sample candidates
+            raise ValueError(f"--candidates must be >= 1, got {self.candidates}")
+
 
 @dataclass(frozen=True, kw_only=True)
 class PlanConfig(SfmOption):

@@ -17,6 +17,7 @@ actors included) then only read the cache.
 from __future__ import annotations
 
 import hashlib
+import io
 import json
 import math
 from collections.abc import Callable
@@ -27,7 +28,8 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from common.io import atomic_path, cache_dir
+from common.cache import write_cache
+from common.io import cache_dir
 from nbv.fanout.task import Task
 from nbv.features.sift import FeatureConfig, extract_features
 from nbv.features.source import gray_frame
@@ -123,9 +125,9 @@ def build_lattice(scene: Scene, make_renderer: Callable[[], MitsubaRenderer], co
     counts = torch.tensor([len(d) for d in descriptors], dtype=torch.long)
     stacked = torch.from_numpy(np.stack(frames))
     flat = torch.cat(descriptors) if descriptors else torch.zeros(0, 128)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        torch.save({"frames": stacked, "counts": counts, "descriptors": flat.half()}, tmp)
+    buffer = io.BytesIO()  # saved in memory first: torch.save hides a full disk's errno in a RuntimeError
+    torch.save({"frames": stacked, "counts": counts, "descriptors": flat.half()}, buffer)
+    write_cache(path, lambda tmp: tmp.write_bytes(buffer.getbuffer()))  # locked; if it fails: a warning
     return ViewLattice(stacked.numpy(), counts.numpy(), flat.half().float(), axes)
 
 

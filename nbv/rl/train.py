@@ -229,12 +229,13 @@ def make_run_collector(config: TrainConfig, actor: ProbabilisticActor, frames: i
 
 class RunLog:
     """A run's training logs: `metrics.csv` (appended to when resuming, after `trim_log` cut it back to the
-    checkpoint), TensorBoard scalars under
-    `tensorboard/`, the progress bar, and the learning curves `training.png` at each checkpoint."""
+    checkpoint), TensorBoard scalars under `tensorboard/` (those past the checkpoint `frames` purged),
+    the progress bar, and the learning curves `training.png` at each checkpoint."""
 
     def __init__(self, run: Path, config: TrainConfig, frames: int) -> None:
         self.run, self.csv_path = run, run / METRICS_CSV
-        self._writer = SummaryWriter(str(run / "tensorboard"))
+        # Steps past the checkpoint were logged by the run that died after it: TensorBoard drops them.
+        self._writer = SummaryWriter(str(run / "tensorboard"), purge_step=frames + 1)
         new_csv = not self.csv_path.is_file() or self.csv_path.stat().st_size == 0
         self._file = open(self.csv_path, "a", newline="")
         self._csv = csv.DictWriter(self._file, CSV_FIELDS)

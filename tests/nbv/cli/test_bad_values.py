@@ -30,6 +30,7 @@ CASES = [
     (SCAN + ["--end-overlap", "0.99999999"], "end_overlap"),
     (PLAN + ["--views", "0"], "views"),
     (PLAN + ["--metric-points", "0"], "--metric-points"),
+    (PLAN + ["--planner", "circle", "--candidates", "0"], "--candidates"),
     (SCAN + ["--seed", "-5"], "--seed"),
     (TRAIN + ["--gamma", "2"], "gamma"),
     (TRAIN + ["--gamma", "0"], "gamma"),

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 import trimesh
-from scipy.spatial import distance_matrix
+from scipy.spatial import cKDTree, distance_matrix
 
 from nbv.recon.metrics import (
     MetricsConfig,
@@ -13,6 +15,7 @@ from nbv.recon.metrics import (
     evaluate_surfaces,
     load_geometry,
     nearest_distances,
+    point_tree,
     sample_points,
 )
 
@@ -47,6 +50,30 @@ def test_nearest_distances_match_brute_force() -> None:
     rng = np.random.default_rng(3)
     query, ref = rng.normal(size=(300, 3)), rng.normal(size=(400, 3))
     np.testing.assert_allclose(nearest_distances(query, ref), distance_matrix(query, ref).min(1), rtol=1e-12)
+
+
+def walls_with_float_noise(n: int, rng: np.random.Generator) -> np.ndarray:
+    """Four walls of a 1 x 0.6 x 0.8 m box, each point 1e-9 m off its plane: a TSDF reconstruction of
+    flat walls, the set SciPy's default tree cannot prune for far queries."""
+    side, u, z = rng.integers(0, 4, n), rng.random(n), rng.random(n) * 0.8
+    x = np.where(side < 2, np.where(side == 0, -0.5, 0.5), u - 0.5)
+    y = np.where(side < 2, 0.6 * u - 0.3, np.where(side == 2, -0.3, 0.3))
+    return np.column_stack([x, y, z]) + rng.normal(0.0, 1e-9, (n, 3))
+
+
+def test_nearest_distances_are_scipys_default_bits_and_fast_on_thin_walls() -> None:
+    rng = np.random.default_rng(4)
+    walls = walls_with_float_noise(100_000, rng)
+    floor = np.column_stack([rng.uniform(-0.5, 0.5, 1500), rng.uniform(-0.3, 0.3, 1500), np.zeros(1500)])
+    assert np.array_equal(nearest_distances(floor, walls), cKDTree(walls).query(floor, k=1)[0])
+    assert np.array_equal(nearest_distances(walls[:5000], floor), cKDTree(floor).query(walls[:5000], k=1)[0])
+    default, ours = cKDTree(walls), point_tree(walls)
+    seconds = []
+    for tree in (default, ours):
+        start = time.process_time()
+        tree.query(floor, k=1, workers=1)
+        seconds.append(time.process_time() - start)
+    assert seconds[1] * 3 < seconds[0], seconds
 
 
 def test_parallel_unit_squares_one_centimetre_apart() -> None:

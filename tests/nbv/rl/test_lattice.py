@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+import errno
 import math
+import os
+import signal
+from pathlib import Path
 
 import numpy as np
 import pytest
 import torch
+from lock_holder import hold
 from tensordict import TensorDict
 
 from nbv.bov.config import BoVConfig
@@ -15,12 +20,14 @@ from nbv.features.sift import extract_features
 from nbv.features.source import gray_frame
 from nbv.rl.config import EnvConfig, LatticeConfig
 from nbv.rl.env import NBVEnv
-from nbv.rl.lattice import ViewLattice, lattice_axes
+from nbv.rl.lattice import ViewLattice, build_lattice, lattice_axes, lattice_path
 from render.camera import UAVCamera
 from render.settings import RenderSettings
+from render.variant import select_variant
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes.spec import SceneSet
 
+ENOSPC = OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 GRID = LatticeConfig(enabled=True, lattice_radii=3, lattice_azimuths=36, lattice_elevations=6)
 
 
@@ -143,3 +150,44 @@ def test_lattice_units_on_local_workers_cache_what_the_env_renders(tmp_path, mon
     assert lattice_tasks(cfg)[0].done()  # (the cache key differs: scene textures live in the cache)
     a, b = torch.load(here.result, weights_only=True), torch.load(unit.result, weights_only=True)
     assert all(torch.equal(a[key], b[key]) for key in ("frames", "counts", "descriptors"))
+
+
+class NoiseRenderer:
+    """A stand-in renderer: seeded noise for each node, no Mitsuba."""
+
+    center = np.zeros(3)
+
+    def render_rgb(self, c2w, seed: int) -> np.ndarray:
+        return np.random.default_rng(seed).integers(0, 256, (48, 64, 3), dtype=np.uint8)
+
+
+def test_lattice_cache_entry_is_written_by_one_run_and_a_failing_write_only_warns(tmp_path, monkeypatch):
+    monkeypatch.setenv("NBV_CACHE_DIR", str(tmp_path))
+    grid = LatticeConfig(enabled=True, lattice_radii=1, lattice_azimuths=2, lattice_elevations=1)
+    cfg = config(grid, camera=UAVCamera(64, 48), obs_size=16,
+                 bov=BoVConfig(sift=FeatureConfig(backend="opencv")))
+    scene, features = cfg.scenes.specs()[0].load(), cfg.bov.feature_config()
+    path = lattice_path(scene, cfg, features, select_variant(cfg.render.variant).variant())
+
+    def build() -> ViewLattice:
+        return build_lattice(scene, NoiseRenderer, cfg, features, progress=False)
+
+    holder = hold(path)  # another run rendering this very lattice
+    try:
+        busy = build()
+    finally:
+        holder.send_signal(signal.SIGKILL)
+        holder.wait()
+        holder.stdout.close()
+    assert not path.exists()  # left to the run that holds it
+    with monkeypatch.context() as full_disk:
+        full_disk.setattr(Path, "write_bytes", lambda *a, **k: (_ for _ in ()).throw(ENOSPC))
+        with pytest.warns(UserWarning, match=rf"^cache {path} not written \(no space left on device \(ENO"):
+            full = build()
+    assert not path.exists()
+    build()
+    cached = build_lattice(scene, lambda: pytest.fail("rendered a cached lattice"), cfg, features,
+                           progress=False)
+    for lattice in (busy, full):
+        assert np.array_equal(lattice.frames, cached.frames)
+        assert all(torch.equal(lattice.observe(i)[1], cached.observe(i)[1]) for i in range(2))

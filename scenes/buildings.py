@@ -12,12 +12,14 @@ porch, steps, columns). `build_building` turns it into a normalised `Scene`
 from __future__ import annotations
 
 import math
+import zlib
 from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
 
 from scenes.csg import SolidBuilder
+from scenes.detail import detail_part
 from scenes.facade import Opening, balcony, cut_opening, fit_opening, quoins, timber_frame
 from scenes.model import Lighting, Scene
 from scenes.normalise import make_ground, normalise_parts
@@ -436,15 +438,22 @@ def assemble(spec: BuildingSpec, seed: int, builder: SolidBuilder | None = None)
     return a.b
 
 
-def textured_scene(name: str, triangles: dict[str, np.ndarray], spec: BuildingSpec, seed: int) -> Scene:
-    """The normalised `Scene` of `triangles` with the finishes, ground and light of `spec`."""
+def textured_scene(name: str, triangles: dict[str, np.ndarray], spec: BuildingSpec, seed: int,
+                   detail: bool = True) -> Scene:
+    """The normalised `Scene` of `triangles` with the finishes, ground and light of `spec`; with `detail`,
+    each part's texture baked with unique surface detail seeded by `name`, `seed` and the part
+    (`scenes.detail`), else the tileable textures repeated."""
     parts = textured_parts(triangles, spec.finishes, seed)
     lo = np.min([p.vertices.min(0) for p in parts], axis=0)
     hi = np.max([p.vertices.max(0) for p in parts], axis=0)
     ground = make_ground(spec.ground, seed, center=(lo + hi)[:2] / 2, half_m=3.2 * float(np.max(hi - lo)))
-    return Scene(name, normalise_parts(parts + [ground]), spec.lighting)
+    parts.append(ground)
+    if detail:
+        parts = [detail_part(p, zlib.crc32(f"{name} {seed} {p.name}".encode())) for p in parts]
+    return Scene(name, normalise_parts(parts), spec.lighting)
 
 
-def build_building(name: str, spec: BuildingSpec, seed: int = 0) -> Scene:
-    """The normalised, textured `Scene` of `spec` (textures and random details seeded by `seed`)."""
-    return textured_scene(name, assemble(spec, seed).triangles(), spec, seed)
+def build_building(name: str, spec: BuildingSpec, seed: int = 0, detail: bool = True) -> Scene:
+    """The normalised, textured `Scene` of `spec` (textures and random details seeded by `seed`; `detail`
+    as in `textured_scene`)."""
+    return textured_scene(name, assemble(spec, seed).triangles(), spec, seed, detail)

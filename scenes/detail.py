@@ -1,0 +1,169 @@
+"""Surface detail that does not repeat across a building: one texture atlas baked per part.
+
+A tileable material (`scenes.textures`) repeats every tile, and the near-symmetric
+sides of a building then look alike: structure from motion matches a wall with the
+one opposite and the model folds (docs/sfm.md). Real walls are weathered, stained,
+signed and overgrown differently everywhere. `detail_part` turns a part textured
+by tiled UVs into one whose UVs span each planar face (a chart) once, in an atlas
+baked for that part: the tiled material sampled where the face lies, at
+`DENSITY_PX_PER_M`, times detail seeded by building and part (large-scale
+weathering, stains, rain streaks, flecks, a tint per face, dirt and moss at the
+base of walls, posters and signs on large walls). The detail is keyed by the
+face's position on the building, so no two faces carry the same one.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from dataclasses import replace
+
+import cv2
+import numpy as np
+from PIL import Image
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+
+from common.io import atomic_path, cache_dir
+from scenes.model import Part
+from scenes.surface import make_part
+from scenes.weathering import Chart, weather
+
+DETAIL_VERSION = 1
+"""Bumped whenever the baking changes, so stale atlases are never reused."""
+DENSITY_PX_PER_M = 64.0
+"""Atlas texels per metre of real (not yet normalised) surface, where the atlas budget allows."""
+MAX_ATLAS_PX = 2048 * 2048
+"""Most texels of one part's atlas: larger parts (the ground) are baked coarser."""
+MIN_FILL = 0.3
+"""Least share of its bounding box a chart's faces must cover to be baked as one block."""
+PAD_PX = 2
+"""Texels of the tiled material around each chart, so bilinear lookups at its edge stay on it."""
+
+
+def detail_part(part: Part, seed: int) -> Part:
+    """`part` (UVs in tiles of its material's tileable texture) with a unique baked atlas, seeded by
+    `seed`; a part of one colour is returned as it is."""
+    if part.material.texture is None or part.uv is None:
+        return part
+    corners, uvs = part.vertices[part.faces], part.uv[part.faces]
+    tile = np.asarray(Image.open(part.material.texture).convert("RGB"), dtype=np.float32) / 255.0
+    atlas_uv, atlas = _layout(corners, uvs, chart_labels(corners), tile, seed)
+    key = hashlib.sha1(b"%d %d " % (DETAIL_VERSION, seed))
+    for array in (corners, atlas_uv):
+        key.update(np.ascontiguousarray(array, dtype=np.float64).tobytes())
+    key.update(repr(part.material).encode())
+    name = f"{part.material.texture.stem}_{key.hexdigest()[:16]}_v{DETAIL_VERSION}.png"
+    path = cache_dir() / "atlases" / name
+    if not path.exists():
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with atomic_path(path) as tmp:
+            Image.fromarray(atlas.bake()).save(tmp, format="PNG", compress_level=1)
+    material = replace(part.material, texture=path)
+    return make_part(part.name, corners, atlas_uv, material, part.target)
+
+
+def chart_labels(corners: np.ndarray) -> np.ndarray:
+    """(F,) chart index of each of (F, 3, 3) triangles: triangles in one plane (normal to 1e-3, offset to
+    1 cm) joined by shared corners share a chart."""
+    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True) + 1e-300
+    offset = np.einsum("fk,fk->f", normal, corners[:, 0])
+    rows = np.concatenate([np.round(normal * 1e3), np.round(offset * 1e2)[:, None]], 1)
+    plane = np.unique(rows, axis=0, return_inverse=True)[1].reshape(-1)
+    keys = np.concatenate([np.repeat(plane, 3)[:, None], np.round(corners.reshape(-1, 3) * 1e6)], 1)
+    corner = np.unique(keys, axis=0, return_inverse=True)[1].reshape(-1, 3)
+    edges = np.concatenate([corner[:, [0, 1]], corner[:, [1, 2]]])
+    count = int(corner.max()) + 1
+    graph = coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(count, count))
+    labels = connected_components(graph, directed=False)[1][corner[:, 0]]
+    return _split_sparse(corners, labels)
+
+
+def _split_sparse(corners: np.ndarray, labels: np.ndarray) -> np.ndarray:
+    """`labels` with each chart that fills under `MIN_FILL` of its bounding box (a ring of trim round a
+    building) split into one chart per triangle, so the atlas holds no large empty blocks."""
+    cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    area = 0.5 * np.linalg.norm(cross, axis=1)
+    count = int(labels.max()) + 1
+    lo, hi = np.full((count, 3), np.inf), np.full((count, 3), -np.inf)
+    np.minimum.at(lo, labels, corners.min(1))
+    np.maximum.at(hi, labels, corners.max(1))
+    extent = np.sort(hi - lo, axis=1)
+    box = extent[:, 1] * extent[:, 2]
+    sparse = np.bincount(labels, area, count) < MIN_FILL * box
+    return np.unique(np.where(sparse[labels], count + np.arange(len(labels)), labels), return_inverse=True)[1]
+
+
+class _Atlas:
+    """Charts packed in shelves: where each lies, its tiled material, then the detail over it."""
+
+    def __init__(self, tile: np.ndarray, texel_per_tile: int, tile_m: float, seed: int) -> None:
+        self.tile, self.s, self.px_per_m = tile, texel_per_tile, texel_per_tile / tile_m
+        self.rng = np.random.default_rng(seed)
+        self.blocks: list[Chart] = []
+
+    def bake(self) -> np.ndarray:
+        """The atlas as a uint8 sRGB image."""
+        width = max(b.x + b.w for b in self.blocks)
+        height = max(b.y + b.h for b in self.blocks)
+        image = np.zeros((height, width, 3), np.float32)
+        for b in self.blocks:
+            rows, cols = (b.ov + np.arange(b.h)) % self.s, (b.ou + np.arange(b.w)) % self.s
+            image[b.y:b.y + b.h, b.x:b.x + b.w] = self.tile[np.ix_(rows, cols)]
+        weather(image, self.blocks, self.s, self.px_per_m, self.rng)
+        return np.round(np.clip(image, 0.0, 1.0) * 255.0).astype(np.uint8)
+
+
+def _layout(corners: np.ndarray, uvs: np.ndarray, labels: np.ndarray, tile: np.ndarray,
+            seed: int) -> tuple[np.ndarray, _Atlas]:
+    """Atlas UVs of every corner (F, 3, 2) and the atlas they index, its charts packed in shelves."""
+    count = int(labels.max()) + 1
+    lo = np.full((count, 2), np.inf)
+    hi = np.full((count, 2), -np.inf)
+    np.minimum.at(lo, labels, uvs.min(1))
+    np.maximum.at(hi, labels, uvs.max(1))
+    tile_m = _tile_metres(corners, uvs)
+    area_m2 = float(np.prod(hi - lo, axis=1).sum()) * tile_m**2
+    density = min(DENSITY_PX_PER_M, math.sqrt(MAX_ATLAS_PX / 1.3 / max(area_m2, 1e-9)))
+    s = max(4, min(tile.shape[0], int(round(density * tile_m))))
+    if s != tile.shape[0]:
+        tile = cv2.resize(tile, (s, s), interpolation=cv2.INTER_AREA)
+    atlas = _Atlas(tile, s, tile_m, seed)
+    origin = np.floor(lo * s).astype(int) - PAD_PX
+    size = np.ceil(hi * s).astype(int) + PAD_PX - origin
+    place = _shelves(size, max(int(size[:, 0].max()), int(math.sqrt(float(np.prod(size, 1).sum())) * 1.1)))
+    for c in range(count):
+        atlas.blocks.append(Chart(int(origin[c, 0]), int(origin[c, 1]), int(place[c, 0]), int(place[c, 1]),
+                                  int(size[c, 0]), int(size[c, 1]), _chart_frame(corners, uvs, labels == c)))
+    width = int((place[:, 0] + size[:, 0]).max())
+    height = int((place[:, 1] + size[:, 1]).max())
+    texel = uvs * s - origin[labels][:, None, :] + place[labels][:, None, :]
+    return texel / np.array([width, height]), atlas
+
+
+def _tile_metres(corners: np.ndarray, uvs: np.ndarray) -> float:
+    """Metres of surface per UV unit, from the largest triangle (planar UVs keep lengths)."""
+    edges = corners[:, 1] - corners[:, 0]
+    k = int(np.argmax(np.linalg.norm(edges, axis=1)))
+    return float(np.linalg.norm(edges[k]) / max(np.linalg.norm(uvs[k, 1] - uvs[k, 0]), 1e-12))
+
+
+def _chart_frame(corners: np.ndarray, uvs: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """(3, 3) affine map of a chart from (u, v, 1) in tiles to world position (least squares)."""
+    points, coords = corners[mask].reshape(-1, 3), uvs[mask].reshape(-1, 2)
+    design = np.concatenate([coords, np.ones((len(coords), 1))], 1)
+    return np.linalg.lstsq(design, points, rcond=None)[0].T
+
+
+def _shelves(size: np.ndarray, width: int) -> np.ndarray:
+    """(C, 2) top-left texel of each of (C, 2) block sizes, packed in rows at most `width` wide, tallest
+    first."""
+    place = np.zeros_like(size)
+    x = y = shelf = 0
+    for c in np.argsort(-size[:, 1], kind="stable"):
+        if x + size[c, 0] > width:
+            x, y, shelf = 0, y + shelf, 0
+        place[c] = (x, y)
+        x, shelf = x + size[c, 0], max(shelf, int(size[c, 1]))
+    return place

@@ -31,7 +31,7 @@ from scenes.weathering import Chart, weather
 
 DETAIL_VERSION = 1
 """Bumped whenever the baking changes, so stale atlases are never reused."""
-DENSITY_PX_PER_M = 64.0
+DENSITY_PX_PER_M = 48.0
 """Atlas texels per metre of real (not yet normalised) surface, where the atlas budget allows."""
 MAX_ATLAS_PX = 2048 * 2048
 """Most texels of one part's atlas: larger parts (the ground) are baked coarser."""

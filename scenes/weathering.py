@@ -72,19 +72,26 @@ def weather(image: np.ndarray, charts: list[Chart], texel_per_tile: int, px_per_
             rng: np.random.Generator) -> None:
     """Lay the detail over `image` (linear-ish sRGB floats, (H, W, 3)) in place."""
     shape = image.shape[:2]
-    image *= np.exp(0.22 * fractal(shape, (4.0, 2.0, 1.0, 0.5), px_per_m, rng))[..., None]
-    stain = np.clip((fractal(shape, (1.2, 0.6, 0.3, 0.15), px_per_m, rng) - 0.8) / 0.5, 0.0, 1.0)
+    half, coarse = ((shape[0] + 1) // 2, (shape[1] + 1) // 2), px_per_m / 2
+    stain = np.clip((fractal(half, (1.2, 0.6, 0.3, 0.15), coarse, rng) - 0.8) / 0.5, 0.0, 1.0)
     colour = rng.uniform((0.18, 0.16, 0.1), (0.4, 0.36, 0.3)).astype(np.float32)
-    image[:] = image * (1.0 - 0.55 * stain[..., None]) + 0.55 * stain[..., None] * colour * 0.6
-    streak = fractal(shape, (1.0, 0.5), px_per_m * 0.08, rng, stretch=12.0)
-    image *= (1.0 - 0.3 * np.clip((streak - 1.0) / 0.6, 0.0, 1.0))[..., None]
+    shade = np.exp(0.22 * fractal(half, (4.0, 2.0, 1.0, 0.5), coarse, rng))
+    streak = fractal(half, (1.0, 0.5), coarse * 0.08, rng, stretch=12.0)
+    shade *= (1.0 - 0.3 * np.clip((streak - 1.0) / 0.6, 0.0, 1.0)) * (1.0 - 0.55 * stain)
     fleck = value_noise(shape, (0.05 * px_per_m,) * 2, rng)
-    image *= (1.0 - 0.5 * np.clip((fleck - 1.8) / 0.4, 0.0, 1.0))[..., None]
+    image *= (_full(shade, shape) * (1.0 - 0.5 * np.clip((fleck - 1.8) / 0.4, 0.0, 1.0)))[..., None]
+    image += _full(0.33 * stain, shape)[..., None] * colour
     for chart in charts:
         region = image[chart.y:chart.y + chart.h, chart.x:chart.x + chart.w]
         region *= (rng.uniform(0.82, 1.15) * (1.0 + rng.normal(0.0, 0.05, 3))).astype(np.float32)
         if abs(chart.normal()[2]) < 0.3:
             _wall(region, chart, texel_per_tile, px_per_m, rng)
+
+
+def _full(field: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """A half-resolution field brought to `shape` (bilinear)."""
+    return cv2.resize(field, (field.shape[1] * 2, field.shape[0] * 2), interpolation=cv2.INTER_LINEAR)[
+        : shape[0], : shape[1]]
 
 
 def _wall(region: np.ndarray, chart: Chart, texel_per_tile: int, px_per_m: float,

@@ -17,6 +17,7 @@ from __future__ import annotations
 import hashlib
 import math
 from dataclasses import replace
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -47,20 +48,19 @@ def detail_part(part: Part, seed: int) -> Part:
     if part.material.texture is None or part.uv is None:
         return part
     corners, uvs = part.vertices[part.faces], part.uv[part.faces]
-    tile = np.asarray(Image.open(part.material.texture).convert("RGB"), dtype=np.float32) / 255.0
-    atlas_uv, atlas = _layout(corners, uvs, chart_labels(corners), tile, seed)
+    atlas = _Atlas(corners, uvs, part.material.texture)
     key = hashlib.sha1(b"%d %d " % (DETAIL_VERSION, seed))
-    for array in (corners, atlas_uv):
+    for array in (corners, atlas.uv):
         key.update(np.ascontiguousarray(array, dtype=np.float64).tobytes())
-    key.update(repr(part.material).encode())
+    key.update(repr(replace(part.material, texture=Path(part.material.texture.name))).encode())
     name = f"{part.material.texture.stem}_{key.hexdigest()[:16]}_v{DETAIL_VERSION}.png"
     path = cache_dir() / "atlases" / name
     if not path.exists():
         path.parent.mkdir(parents=True, exist_ok=True)
         with atomic_path(path) as tmp:
-            Image.fromarray(atlas.bake()).save(tmp, format="PNG", compress_level=1)
+            Image.fromarray(atlas.bake(np.random.default_rng(seed))).save(tmp, format="PNG", compress_level=1)
     material = replace(part.material, texture=path)
-    return make_part(part.name, corners, atlas_uv, material, part.target)
+    return make_part(part.name, corners, atlas.uv, material, part.target)
 
 
 def chart_labels(corners: np.ndarray) -> np.ndarray:
@@ -96,50 +96,42 @@ def _split_sparse(corners: np.ndarray, labels: np.ndarray) -> np.ndarray:
 
 
 class _Atlas:
-    """Charts packed in shelves: where each lies, its tiled material, then the detail over it."""
+    """A part's charts packed in shelves (`uv`: every corner's atlas UV), baked on demand."""
 
-    def __init__(self, tile: np.ndarray, texel_per_tile: int, tile_m: float, seed: int) -> None:
-        self.tile, self.s, self.px_per_m = tile, texel_per_tile, texel_per_tile / tile_m
-        self.rng = np.random.default_rng(seed)
-        self.blocks: list[Chart] = []
+    def __init__(self, corners: np.ndarray, uvs: np.ndarray, tile_path: Path) -> None:
+        self.corners, self.uvs, self.tile_path = corners, uvs, tile_path
+        self.labels = chart_labels(corners)
+        count = int(self.labels.max()) + 1
+        lo, hi = np.full((count, 2), np.inf), np.full((count, 2), -np.inf)
+        np.minimum.at(lo, self.labels, uvs.min(1))
+        np.maximum.at(hi, self.labels, uvs.max(1))
+        self.tile_m = _tile_metres(corners, uvs)
+        area_m2 = float(np.prod(hi - lo, axis=1).sum()) * self.tile_m**2
+        density = min(DENSITY_PX_PER_M, math.sqrt(MAX_ATLAS_PX / 1.3 / max(area_m2, 1e-9)))
+        self.s = max(4, min(Image.open(tile_path).size[0], int(round(density * self.tile_m))))
+        self.origin = np.floor(lo * self.s).astype(int) - PAD_PX
+        self.size = np.ceil(hi * self.s).astype(int) + PAD_PX - self.origin
+        width = max(int(self.size[:, 0].max()), int(math.sqrt(float(np.prod(self.size, 1).sum())) * 1.1))
+        self.place = _shelves(self.size, width)
+        extent = (self.place + self.size).max(0)
+        texel = uvs * self.s - self.origin[self.labels][:, None, :] + self.place[self.labels][:, None, :]
+        self.uv = texel / extent
 
-    def bake(self) -> np.ndarray:
-        """The atlas as a uint8 sRGB image."""
-        width = max(b.x + b.w for b in self.blocks)
-        height = max(b.y + b.h for b in self.blocks)
+    def bake(self, rng: np.random.Generator) -> np.ndarray:
+        """The atlas as a uint8 sRGB image: the tiled material under each chart, weathered."""
+        tile = np.asarray(Image.open(self.tile_path).convert("RGB"), dtype=np.float32) / 255.0
+        if self.s != tile.shape[0]:
+            tile = cv2.resize(tile, (self.s, self.s), interpolation=cv2.INTER_AREA)
+        width, height = (self.place + self.size).max(0)
         image = np.zeros((height, width, 3), np.float32)
-        for b in self.blocks:
+        frames = _chart_frames(self.corners, self.uvs, self.labels, len(self.size))
+        charts = [Chart(*(int(k) for k in (*o, *p, *z)), frame=f)
+                  for o, p, z, f in zip(self.origin, self.place, self.size, frames)]
+        for b in charts:
             rows, cols = (b.ov + np.arange(b.h)) % self.s, (b.ou + np.arange(b.w)) % self.s
-            image[b.y:b.y + b.h, b.x:b.x + b.w] = self.tile[np.ix_(rows, cols)]
-        weather(image, self.blocks, self.s, self.px_per_m, self.rng)
+            image[b.y:b.y + b.h, b.x:b.x + b.w] = tile[np.ix_(rows, cols)]
+        weather(image, charts, self.s, self.s / self.tile_m, rng)
         return np.round(np.clip(image, 0.0, 1.0) * 255.0).astype(np.uint8)
-
-
-def _layout(corners: np.ndarray, uvs: np.ndarray, labels: np.ndarray, tile: np.ndarray,
-            seed: int) -> tuple[np.ndarray, _Atlas]:
-    """Atlas UVs of every corner (F, 3, 2) and the atlas they index, its charts packed in shelves."""
-    count = int(labels.max()) + 1
-    lo = np.full((count, 2), np.inf)
-    hi = np.full((count, 2), -np.inf)
-    np.minimum.at(lo, labels, uvs.min(1))
-    np.maximum.at(hi, labels, uvs.max(1))
-    tile_m = _tile_metres(corners, uvs)
-    area_m2 = float(np.prod(hi - lo, axis=1).sum()) * tile_m**2
-    density = min(DENSITY_PX_PER_M, math.sqrt(MAX_ATLAS_PX / 1.3 / max(area_m2, 1e-9)))
-    s = max(4, min(tile.shape[0], int(round(density * tile_m))))
-    if s != tile.shape[0]:
-        tile = cv2.resize(tile, (s, s), interpolation=cv2.INTER_AREA)
-    atlas = _Atlas(tile, s, tile_m, seed)
-    origin = np.floor(lo * s).astype(int) - PAD_PX
-    size = np.ceil(hi * s).astype(int) + PAD_PX - origin
-    place = _shelves(size, max(int(size[:, 0].max()), int(math.sqrt(float(np.prod(size, 1).sum())) * 1.1)))
-    for c in range(count):
-        atlas.blocks.append(Chart(int(origin[c, 0]), int(origin[c, 1]), int(place[c, 0]), int(place[c, 1]),
-                                  int(size[c, 0]), int(size[c, 1]), _chart_frame(corners, uvs, labels == c)))
-    width = int((place[:, 0] + size[:, 0]).max())
-    height = int((place[:, 1] + size[:, 1]).max())
-    texel = uvs * s - origin[labels][:, None, :] + place[labels][:, None, :]
-    return texel / np.array([width, height]), atlas
 
 
 def _tile_metres(corners: np.ndarray, uvs: np.ndarray) -> float:
@@ -149,11 +141,15 @@ def _tile_metres(corners: np.ndarray, uvs: np.ndarray) -> float:
     return float(np.linalg.norm(edges[k]) / max(np.linalg.norm(uvs[k, 1] - uvs[k, 0]), 1e-12))
 
 
-def _chart_frame(corners: np.ndarray, uvs: np.ndarray, mask: np.ndarray) -> np.ndarray:
-    """(3, 3) affine map of a chart from (u, v, 1) in tiles to world position (least squares)."""
-    points, coords = corners[mask].reshape(-1, 3), uvs[mask].reshape(-1, 2)
-    design = np.concatenate([coords, np.ones((len(coords), 1))], 1)
-    return np.linalg.lstsq(design, points, rcond=None)[0].T
+def _chart_frames(corners: np.ndarray, uvs: np.ndarray, labels: np.ndarray, count: int) -> np.ndarray:
+    """(C, 3, 3) affine map of each chart from (u, v, 1) in tiles to world position (least squares)."""
+    design = np.concatenate([uvs, np.ones(uvs.shape[:2] + (1,))], 2).reshape(-1, 3)
+    which = np.repeat(labels, 3)
+    normal = np.zeros((count, 3, 3))
+    moment = np.zeros((count, 3, 3))
+    np.add.at(normal, which, design[:, :, None] * design[:, None, :])
+    np.add.at(moment, which, design[:, :, None] * corners.reshape(-1, 3)[:, None, :])
+    return np.linalg.solve(normal + 1e-9 * np.eye(3), moment).transpose(0, 2, 1)
 
 
 def _shelves(size: np.ndarray, width: int) -> np.ndarray:

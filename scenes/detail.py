@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import zlib
 from dataclasses import replace
 from pathlib import Path
 
@@ -61,6 +62,12 @@ def detail_part(part: Part, seed: int) -> Part:
             Image.fromarray(atlas.bake(np.random.default_rng(seed))).save(tmp, format="PNG", compress_level=1)
     material = replace(part.material, texture=path)
     return make_part(part.name, corners, atlas.uv, material, part.target)
+
+
+def detailed(parts: list[Part], building: str) -> list[Part]:
+    """Every part of a building through `detail_part`, seeded by `building` (its name and seed) and the
+    part's name."""
+    return [detail_part(p, zlib.crc32(f"{building} {p.name}".encode())) for p in parts]
 
 
 def chart_labels(corners: np.ndarray) -> np.ndarray:

@@ -60,7 +60,7 @@ def test_opposite_walls_of_a_symmetric_box_get_different_textures():
                       Material("walls", texture=texture_path("plaster_white", 0, size=64)))
     tile = np.asarray(Image.open(tiled.material.texture).convert("RGB"))
     tiled_uv = tiled.uv[tiled.faces]
-    assert np.allclose(tiled_uv[0], tiled_uv[4])  # the tiled look: front and back walls sample the same texels
+    assert np.allclose(tiled_uv[0], tiled_uv[4])  # tiled: front and back walls sample the same texels
     detailed = detail_part(tiled, seed=1)
     atlas = np.asarray(Image.open(detailed.material.texture).convert("RGB"))
     assert detailed.material.texture != tiled.material.texture and atlas.shape[0] > tile.shape[0]

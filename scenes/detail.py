@@ -45,23 +45,29 @@ PAD_PX = 2
 
 def detail_part(part: Part, seed: int) -> Part:
     """`part` (UVs in tiles of its material's tileable texture) with a unique baked atlas, seeded by
-    `seed`; a part of one colour is returned as it is."""
+    `seed`; a part of one colour is returned as it is. The atlas and the part's new arrays are cached,
+    named by a hash of the part and the seed, so a warm build only reads them back."""
     if part.material.texture is None or part.uv is None:
         return part
     corners, uvs = part.vertices[part.faces], part.uv[part.faces]
-    atlas = _Atlas(corners, uvs, part.material.texture)
     key = hashlib.sha1(b"%d %d " % (DETAIL_VERSION, seed))
-    for array in (corners, atlas.uv):
+    for array in (corners, uvs):
         key.update(np.ascontiguousarray(array, dtype=np.float64).tobytes())
-    key.update(repr(replace(part.material, texture=Path(part.material.texture.name))).encode())
-    name = f"{part.material.texture.stem}_{key.hexdigest()[:16]}_v{DETAIL_VERSION}.png"
-    path = cache_dir() / "atlases" / name
-    if not path.exists():
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with atomic_path(path) as tmp:
-            Image.fromarray(atlas.bake(np.random.default_rng(seed))).save(tmp, format="PNG", compress_level=1)
-    material = replace(part.material, texture=path)
-    return make_part(part.name, corners, atlas.uv, material, part.target)
+    key.update(repr((replace(part.material, texture=Path(part.material.texture.name)), part.target)).encode())
+    stem = cache_dir() / "atlases" / f"{part.material.texture.stem}_{key.hexdigest()[:16]}_v{DETAIL_VERSION}"
+    image, arrays = stem.with_name(stem.name + ".png"), stem.with_name(stem.name + ".npz")
+    material = replace(part.material, texture=image)
+    if image.exists() and arrays.exists():
+        with np.load(arrays) as stored:
+            return Part(part.name, stored["vertices"], stored["faces"], material, stored["uv"], part.target)
+    atlas = _Atlas(corners, uvs, part.material.texture)
+    made = make_part(part.name, corners, atlas.uv, material, part.target)
+    image.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(image) as tmp:
+        Image.fromarray(atlas.bake(np.random.default_rng(seed))).save(tmp, format="PNG", compress_level=1)
+    with atomic_path(arrays) as tmp, open(tmp, "wb") as file:
+        np.savez(file, vertices=made.vertices, faces=made.faces, uv=made.uv)
+    return made
 
 
 def detailed(parts: list[Part], building: str) -> list[Part]:

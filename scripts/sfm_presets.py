@@ -38,21 +38,25 @@ def folder_name(scene: str) -> str:
     return scene.replace(":", "_").replace("@", "_")
 
 
+def outputs(scene: str, runs: Path) -> tuple[Path, Path]:
+    """The scan and SfM folders of one scene."""
+    return runs / f"{folder_name(scene)}-scan", runs / f"{folder_name(scene)}-sfm"
+
+
 def commands(scene: str, runs: Path) -> list[list[str]]:
     """The two `nbv` command lines of one scene."""
-    scan, sfm = runs / f"{folder_name(scene)}-scan", runs / f"{folder_name(scene)}-sfm"
+    scan, sfm = outputs(scene, runs)
     return [["nbv", "scan", scene, "hemisphere", "--out", str(scan), "--overwrite"],
             ["nbv", "sfm", str(scan), "--out", str(sfm), "--matching", "spatial", "--overwrite"]]
 
 
 def run_scene(scene: str, runs: Path, reuse: bool) -> dict:
     """Scan and reconstruct `scene` (each step skipped with `reuse` where its output exists); its sfm.json."""
-    scan_cmd, sfm_cmd = commands(scene, runs)
-    for command, done in ((scan_cmd, Path(scan_cmd[4]) / "transforms.json"),
-                          (sfm_cmd, Path(sfm_cmd[4]) / "sfm.json")):
+    scan, sfm = outputs(scene, runs)
+    for command, done in zip(commands(scene, runs), (scan / "transforms.json", sfm / "sfm.json")):
         if not (reuse and done.exists()):
             subprocess.run([sys.executable, "-m", "nbv.cli", *command[1:]], check=True)
-    return json.loads((Path(sfm_cmd[4]) / "sfm.json").read_text())
+    return json.loads((sfm / "sfm.json").read_text())
 
 
 def row(scene: str, report: dict) -> dict:
@@ -111,9 +115,9 @@ def figures(scenes: list[str], runs: Path, out: Path) -> None:
 
     fig, axes = plt.subplots(1, len(scenes), figsize=(3.2 * len(scenes), 3.4), squeeze=False)
     for ax, scene in zip(axes[0], scenes):
-        base = runs / folder_name(scene)
-        if (Path(f"{base}-sfm") / "sparse" / "0").exists():
-            true, est = fitted_centres(Path(f"{base}-scan"), Path(f"{base}-sfm"))
+        scan, sfm = outputs(scene, runs)
+        if (sfm / "sparse" / "0").exists():
+            true, est = fitted_centres(scan, sfm)
             ax.scatter(true[:, 0], true[:, 1], s=10, facecolors="none", edgecolors="tab:blue", label="true")
             ax.scatter(est[:, 0], est[:, 1], s=3, color="tab:red", label="fitted model")
         ax.set_title(scene, fontsize=9)
@@ -126,7 +130,7 @@ def figures(scenes: list[str], runs: Path, out: Path) -> None:
     plt.close(fig)
     tiles = []
     for scene in scenes:
-        dataset = read_dataset(Path(f"{runs / folder_name(scene)}-scan"))
+        dataset = read_dataset(outputs(scene, runs)[0])
         tiles.append(Image.fromarray(dataset.rgb(len(dataset) * 2 // 3)).resize((240, 180)))
     sheet = Image.new("RGB", (240 * len(tiles), 180))
     for k, tile in enumerate(tiles):
@@ -152,7 +156,13 @@ def main(argv: list[str]) -> int:
                              "centre_error_pct_radius_max": CENTRE_MAX_PCT},
               "scenes": rows}
     (args.out / "presets.json").write_text(json.dumps(record, indent=2) + "\n")
-    (args.out / "presets.md").write_text(markdown(rows))
+    header = (f"# `nbv sfm` on each scene's full 288-view hemisphere scan (320x240, spp 16)\n\nCommit "
+              f"{args.commit or '-'}; acceptance: at least {100 * SHARE_MIN:.0f} % of the views in one "
+              f"model, "
+              f"mean camera-centre error at most {CENTRE_MAX_PCT:g} % of the scan radius (2 m) after the "
+              f"similarity fit. Commands (RUNS: the runs folder):\n\n"
+              + "".join(f"    {c}\n" for c in record["commands"]) + "\n")
+    (args.out / "presets.md").write_text(header + markdown(rows))
     figures(args.scenes, args.runs, args.out)
     print(markdown(rows), end="")
     return 0

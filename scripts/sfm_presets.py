@@ -5,7 +5,7 @@ For every scene: `nbv scan SCENE hemisphere --out RUNS/NAME-scan` (default camer
 already there (`--reuse`). Then it writes OUT/presets.json and OUT/presets.md (registered share, models,
 points, reprojection error, centre and rotation errors after the similarity fit), OUT/presets_centres.png
 (the true camera centres and the fitted model's, seen from above) and OUT/presets_look.png (one render
-of each scene).
+of each preset).
 
     nice -n 5 python scripts/sfm_presets.py --runs sfm_runs --out paper_results/sfm
     nice -n 5 python scripts/sfm_presets.py --runs sfm_runs --out OUT --scenes medieval_tavern@tiled
@@ -128,14 +128,24 @@ def figures(scenes: list[str], runs: Path, out: Path) -> None:
     fig.tight_layout()
     fig.savefig(out / "presets_centres.png", dpi=110)
     plt.close(fig)
-    tiles = []
-    for scene in scenes:
-        dataset = read_dataset(outputs(scene, runs)[0])
-        tiles.append(Image.fromarray(dataset.rgb(len(dataset) * 2 // 3)).resize((240, 180)))
+    tiles = [Image.fromarray(look(scene)).resize((240, 180)) for scene in PRESETS]
     sheet = Image.new("RGB", (240 * len(tiles), 180))
     for k, tile in enumerate(tiles):
         sheet.paste(tile, (240 * k, 0))
     sheet.save(out / "presets_look.png", optimize=True)
+
+
+def look(scene: str) -> np.ndarray:
+    """One 320x240 render (spp 16) of `scene` from radius 2 m, azimuth 30 and elevation 30 degrees."""
+    from render.camera import UAVCamera
+    from render.renderer import MitsubaRenderer
+    from render.settings import RenderSettings
+    from render.viewpoint import Viewpoint, viewpoint_to_c2w
+    from scenes.catalog import load_scene
+
+    renderer = MitsubaRenderer(load_scene(scene), UAVCamera(320, 240), RenderSettings(spp=16))
+    view = Viewpoint(2.0, math.radians(30.0), math.radians(30.0))
+    return renderer.render_rgb(viewpoint_to_c2w(view, renderer.center), seed=0)
 
 
 def main(argv: list[str]) -> int:

@@ -8,8 +8,10 @@ by tiled UVs into one whose UVs span each planar face (a chart) once, in an atla
 baked for that part: the tiled material sampled where the face lies, at
 `DENSITY_PX_PER_M`, times detail seeded by building and part (large-scale
 weathering, stains, rain streaks, flecks, a tint per face, dirt and moss at the
-base of walls, posters and signs on large walls). The detail is keyed by the
-face's position on the building, so no two faces carry the same one.
+base of walls, posters and signs on large walls). Each face gets its own block
+of freshly drawn detail, so no two faces carry the same one. Baked, because
+Mitsuba 3 has no procedural noise texture and no product of two textures (its
+`blendbsdf` blends two BSDFs, and every texture of a shape reads the same UVs).
 """
 
 from __future__ import annotations

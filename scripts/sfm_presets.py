@@ -4,7 +4,7 @@ For every scene: `nbv scan SCENE hemisphere --out RUNS/NAME-scan` (default camer
 `nbv sfm RUNS/NAME-scan --out RUNS/NAME-sfm --matching spatial`, each skipped where its output is
 already there (`--reuse`). Then it writes OUT/presets.json and OUT/presets.md (registered share, models,
 points, reprojection error, centre and rotation errors after the similarity fit), OUT/presets_centres.png
-(the true camera centres and the fitted model's, seen from above) and OUT/presets_look.png (one render
+(the true camera centres and the fitted model's, seen from above) and OUT/presets_look.jpg (one render
 of each preset).
 
     nice -n 5 python scripts/sfm_presets.py --runs sfm_runs --out paper_results/sfm
@@ -106,7 +106,7 @@ def fitted_centres(scan: Path, sfm: Path) -> tuple[np.ndarray, np.ndarray]:
 
 
 def figures(scenes: list[str], runs: Path, out: Path) -> None:
-    """presets_centres.png (centres from above, true and fitted) and presets_look.png (a render each)."""
+    """presets_centres.png (centres from above, true and fitted) and presets_look.jpg (a render each)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -132,7 +132,7 @@ def figures(scenes: list[str], runs: Path, out: Path) -> None:
     sheet = Image.new("RGB", (240 * len(tiles), 180))
     for k, tile in enumerate(tiles):
         sheet.paste(tile, (240 * k, 0))
-    sheet.save(out / "presets_look.png", optimize=True)
+    sheet.save(out / "presets_look.jpg", quality=85)
 
 
 def look(scene: str) -> np.ndarray:

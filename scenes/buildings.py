@@ -18,6 +18,7 @@ from typing import Literal
 import numpy as np
 
 from scenes.csg import SolidBuilder
+from scenes.detail import detailed
 from scenes.facade import Opening, balcony, cut_opening, fit_opening, quoins, timber_frame
 from scenes.model import Lighting, Scene
 from scenes.normalise import make_ground, normalise_parts
@@ -340,12 +341,8 @@ class _Assembly:
         x0, y0, x1, y1 = _grow(self.rects[0], 1.3)
         z_top = self.z[1] - s.overhang * math.tan(math.radians(0.6 * s.pitch_deg)) + 0.05
         spots = set()
-        for a, c, count in (
-            ((x0, y0), (x1, y0), 6),
-            ((x0, y1), (x1, y1), 6),
-            ((x0, y0), (x0, y1), 4),
-            ((x1, y0), (x1, y1), 4),
-        ):
+        for a, c, count in (((x0, y0), (x1, y0), 6), ((x0, y1), (x1, y1), 6), ((x0, y0), (x0, y1), 4),
+                            ((x1, y0), (x1, y1), 4)):
             for k in range(count + 1):
                 t = k / count
                 spots.add((round(a[0] + t * (c[0] - a[0]), 6), round(a[1] + t * (c[1] - a[1]), 6)))
@@ -436,15 +433,18 @@ def assemble(spec: BuildingSpec, seed: int, builder: SolidBuilder | None = None)
     return a.b
 
 
-def textured_scene(name: str, triangles: dict[str, np.ndarray], spec: BuildingSpec, seed: int) -> Scene:
-    """The normalised `Scene` of `triangles` with the finishes, ground and light of `spec`."""
+def textured_scene(name: str, triangles: dict[str, np.ndarray], spec: BuildingSpec, seed: int,
+                   detail: bool = True) -> Scene:
+    """The normalised `Scene` of `triangles` with the finishes, ground and light of `spec`; `detail`: each
+    part's texture baked with unique surface detail (`scenes.detail`), else the tiled textures alone."""
     parts = textured_parts(triangles, spec.finishes, seed)
     lo = np.min([p.vertices.min(0) for p in parts], axis=0)
     hi = np.max([p.vertices.max(0) for p in parts], axis=0)
     ground = make_ground(spec.ground, seed, center=(lo + hi)[:2] / 2, half_m=3.2 * float(np.max(hi - lo)))
-    return Scene(name, normalise_parts(parts + [ground]), spec.lighting)
+    parts = detailed(parts + [ground], f"{name} {seed}") if detail else parts + [ground]
+    return Scene(name, normalise_parts(parts), spec.lighting)
 
 
-def build_building(name: str, spec: BuildingSpec, seed: int = 0) -> Scene:
-    """The normalised, textured `Scene` of `spec` (textures and random details seeded by `seed`)."""
-    return textured_scene(name, assemble(spec, seed).triangles(), spec, seed)
+def build_building(name: str, spec: BuildingSpec, seed: int = 0, detail: bool = True) -> Scene:
+    """The normalised, textured `Scene` of `spec` (seeded by `seed`; `detail` as in `textured_scene`)."""
+    return textured_scene(name, assemble(spec, seed).triangles(), spec, seed, detail)

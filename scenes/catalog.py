@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 from collections import OrderedDict
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -28,6 +29,11 @@ DEFAULT_SCENE = "medieval_tavern"
 """The scene `make demo` uses."""
 RANDOM_PREFIX = "random:"
 """`random:SEED` names a building drawn from the grammar (see `scenes.presets`)."""
+TILED_SUFFIX = "@tiled"
+"""A procedural building's name ending in `@tiled` (`medieval_tavern@tiled`, `random:3@tiled`,
+`family:7@tiled`) loads it with the old look: its tileable textures repeated over every face, without the
+unique surface detail (weathering, stains, posters, growth at the base: `scenes.detail`) that the plain name
+bakes by default."""
 MEMO_SIZE = 8
 """Scenes a process keeps loaded (`load_scene`), the least recently used dropped first."""
 _MEMO: OrderedDict[tuple, Scene] = OrderedDict()
@@ -81,31 +87,54 @@ def _frozen(scene: Scene) -> Scene:
     return scene
 
 
+def split_look(spec: str) -> tuple[str, bool]:
+    """A scene name without `TILED_SUFFIX`, and whether its surfaces get the unique detail (no suffix)."""
+    base = spec.removesuffix(TILED_SUFFIX)
+    if base != spec and not (base in PRESET_NAMES or base.startswith((RANDOM_PREFIX, FAMILY_PREFIX))):
+        raise ValueError(f"bad scene {spec!r}: {TILED_SUFFIX} applies to a preset, random:SEED or "
+                         f"family:SEED only, e.g. medieval_tavern{TILED_SUFFIX}")
+    return base, base == spec
+
+
 def _build(spec: str, up_axis: str) -> Scene:
+    base, detail = split_look(spec)
+    if base != spec:
+        return replace(_build_building(base, detail), name=spec)
+    return _build_building(spec, detail) or _build_other(spec, up_axis)
+
+
+def _build_building(spec: str, detail: bool) -> Scene | None:
+    """A preset, random:SEED or family:SEED building, None for any other name."""
     if spec in PRESET_NAMES:
         from scenes.presets import build_preset
 
-        return build_preset(spec)
-    if spec == TEST_BUILDING:
-        from scenes.toy_house import build_test_building
-
-        return build_test_building()
+        return build_preset(spec, detail=detail)
     if spec.startswith(RANDOM_PREFIX):
         seed = spec[len(RANDOM_PREFIX) :]
         if not seed.isdigit():
             raise ValueError(f"bad scene {spec!r}: expected random:SEED with SEED a non-negative integer")
         from scenes.presets import build_random
 
-        return build_random(int(seed))
+        return build_random(int(seed), detail)
     if spec.startswith(FAMILY_PREFIX):
         from scenes.family import build_family
 
-        return build_family(parse_family(spec))
+        return build_family(parse_family(spec), detail)
+    return None
+
+
+def _build_other(spec: str, up_axis: str) -> Scene:
+    """The test building or a mesh / Mitsuba XML file."""
+    if spec == TEST_BUILDING:
+        from scenes.toy_house import build_test_building
+
+        return build_test_building()
     from scenes.loader import is_scene_file, load_file_scene
 
     if is_scene_file(spec):
         return load_file_scene(spec, up_axis)
     raise ValueError(
         f"unknown scene {spec!r}; built-in scenes: {', '.join(list_scenes())}; "
-        f"or random:SEED, family:SEED, or a mesh / Mitsuba XML file path"
+        f"or random:SEED, family:SEED (each with {TILED_SUFFIX} for the tiled look), or a mesh / Mitsuba XML "
+        f"file path"
     )

@@ -170,8 +170,9 @@ def _perimeter(builder: SolidBuilder, wall: tuple[float, float, float, float, fl
         builder.add(box((lo[0], lo[1], 0.0), (hi[0], hi[1], height)), "compound_wall")
 
 
-def build_family(seed: int) -> Scene:
-    """The normalised, textured building `family:SEED`."""
+def build_family(seed: int, detail: bool = True) -> Scene:
+    """The normalised, textured building `family:SEED` (`detail`: unique surface detail, else the tiled
+    textures alone)."""
     building = family_building(seed)
     builder = SolidBuilder()
     for k, (spec, offset) in enumerate(building.parts):
@@ -179,4 +180,4 @@ def build_family(seed: int) -> Scene:
     if building.wall is not None:
         _perimeter(builder, building.wall)
     look = building.parts[0][0]
-    return textured_scene(f"family:{seed}", builder.triangles(), look, seed % 16)
+    return textured_scene(f"family:{seed}", builder.triangles(), look, seed % 16, detail)

@@ -204,11 +204,11 @@ def split_seeds(split: str, count: int, start: int = 0) -> list[int]:
     return seeds
 
 
-def build_preset(name: str, seed: int = 0) -> Scene:
-    """The preset building `name`."""
+def build_preset(name: str, seed: int = 0, detail: bool = True) -> Scene:
+    """The preset building `name` (`detail`: unique surface detail, else the tiled textures alone)."""
     if name not in PRESETS:
         raise ValueError(f"unknown preset {name!r}; presets: {', '.join(PRESETS)}")
-    return build_building(name, PRESETS[name], seed)
+    return build_building(name, PRESETS[name], seed, detail)
 
 
 _WALLS = (
@@ -289,6 +289,7 @@ def random_spec(seed: int) -> BuildingSpec:
     return spec
 
 
-def build_random(seed: int) -> Scene:
-    """The building `random:SEED` (see the module docstring for the train/test split)."""
-    return build_building(f"random:{seed}", random_spec(seed), seed % 16)
+def build_random(seed: int, detail: bool = True) -> Scene:
+    """The building `random:SEED` (see the module docstring for the train/test split; `detail` as in
+    `build_preset`)."""
+    return build_building(f"random:{seed}", random_spec(seed), seed % 16, detail)

@@ -32,7 +32,8 @@ class SceneSpec(MeshOrientation):
 
     scene: Annotated[str, Positional, arg(metavar="SCENE")]
     """A built-in scene name (see `nbv scene list`), random:SEED, family:SEED, or a mesh / Mitsuba XML file
-    path."""
+    path; a preset, random:SEED or family:SEED with @tiled (medieval_tavern@tiled) has the old tiled
+    textures instead of unique surface detail."""
 
     def load(self) -> Scene:
         """The normalised scene."""
@@ -46,8 +47,8 @@ class SceneSet(MeshOrientation):
     """One or more targets, each given with `--scene` (the up axis applies to every mesh file)."""
 
     scene: Annotated[tuple[str, ...], UseAppendAction]
-    """A built-in scene name, random:SEED, family:SEED, or a mesh file path; give --scene several times for
-    several."""
+    """A built-in scene name, random:SEED, family:SEED (each building with @tiled for the old tiled look), or
+    a mesh file path; give --scene several times for several."""
 
     def __post_init__(self) -> None:
         if not self.scene:

@@ -6,8 +6,10 @@ For each planner (default: the shipped policy, the tuned orbit, random views), e
 training building (`nbv plan`'s `choose_views`, seed 0, the planner's own planning env), they are
 rendered at that resolution (spp 16, cached under $NBV_CACHE_DIR/sfm_register_curve) and `nbv sfm` runs
 on them (exhaustive matching up to `--spatial-above` views, spatial matching by pose above). A set
-registers when at least 90 % of its views are in the largest model. Per planner and resolution the
-counts run in increasing order and stop at the first that registers (`--all-counts`: run them all).
+registers when at least 90 % of its views are in the largest model, and registers right when that
+model's mean camera-centre error after the similarity fit is at most 5 % of the scan radius (a folded
+model registers, wrongly). Per planner and resolution the counts run in increasing order and stop at the
+first that registers right (`--all-counts`: run them all).
 Cases run 13 views first for every planner and resolution, then the larger counts, and the results are
 written after every case, so an interrupted run keeps what it measured:
 
@@ -24,6 +26,7 @@ Held-out buildings are refused: the curve is a measurement on the buildings the 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 from pathlib import Path
@@ -51,6 +54,9 @@ SPP = 16
 """Samples per pixel of the SfM renders (as scripts/sfm_measure.py)."""
 REGISTERED_SHARE = 0.9
 """A set registers when at least this share of its views is in the largest model (issue 29)."""
+RIGHT_PCT_RADIUS = 5.0
+"""A registered set's model is right when its mean camera-centre error after the similarity fit is at
+most this percentage of the scan radius (a folded model is 50 to 100 %)."""
 
 
 def parse_size(text: str) -> tuple[int, int]:
@@ -78,7 +84,9 @@ def headline(report: dict) -> dict:
             "centre_error_cm": pose.get("centre_error_cm", {}).get("mean"),
             "centre_error_pct_radius": pose.get("centre_error_pct_radius", {}).get("mean"),
             "relative_rotation_median_deg": pose.get("relative_rotation_error_deg", {}).get("median"),
-            "registers": report["registered_share"] >= REGISTERED_SHARE, "seconds": report["seconds"]}
+            "registers": report["registered_share"] >= REGISTERED_SHARE, "seconds": report["seconds"],
+            "right": (report["registered_share"] >= REGISTERED_SHARE
+                      and pose.get("centre_error_pct_radius", {}).get("mean", math.inf) <= RIGHT_PCT_RADIUS)}
 
 
 def run_case(args: argparse.Namespace, planner: str, count: int, size: tuple[int, int], views: list) -> dict:
@@ -94,9 +102,10 @@ def run_case(args: argparse.Namespace, planner: str, count: int, size: tuple[int
             "matching": settings.matching, **headline(report)}
 
 
-def smallest(cases: list[dict], planner: str, size: str) -> int | None:
-    """The smallest count at which the planner's views at `size` registered, None if none did."""
-    counts = [c["count"] for c in cases if c["planner"] == planner and c["size"] == size and c["registers"]]
+def smallest(cases: list[dict], planner: str, size: str, key: str = "registers") -> int | None:
+    """The smallest count at which the planner's views at `size` registered (`key` "right": into a right
+    model), None if none did."""
+    counts = [c["count"] for c in cases if c["planner"] == planner and c["size"] == size and c[key]]
     return min(counts) if counts else None
 
 
@@ -109,25 +118,29 @@ def write_outputs(args: argparse.Namespace, cases: list[dict], command: str) -> 
     sizes = [f"{w}x{h}" for w, h in args.sizes]
     rows = [[c["planner"], c["size"], str(c["count"]), f"{c['registered']}/{c['views']}", str(c["models"]),
              fmt(c["centre_error_cm"], ".1f"), fmt(c["centre_error_pct_radius"], ".1f"),
-             fmt(c["relative_rotation_median_deg"], ".1f"), "yes" if c["registers"] else "no"] for c in cases]
+             fmt(c["relative_rotation_median_deg"], ".1f"), "yes" if c["registers"] else "no",
+             "yes" if c["right"] else "no"] for c in cases]
     found = []
     for planner in args.planners:
         for size in sizes:
             mine = [c["count"] for c in cases if (c["planner"], c["size"]) == (planner, size)]
             if mine:
-                least = smallest(cases, planner, size)
-                found.append([planner, size, f"none up to {max(mine)}" if least is None else str(least)])
+                least = [smallest(cases, planner, size, key) for key in ("registers", "right")]
+                none = f"none up to {max(mine)}"
+                found.append([planner, size, *(none if n is None else str(n) for n in least)])
     text = "\n".join([
         f"# Registration per view count and resolution: {args.scene} (commit {git_commit()})", "",
         f"`{command}`", "",
         f"COLMAP (pycolmap, CPU, intrinsics fixed, seed {args.seed}) on each planner's views, rendered at "
         f"spp {SPP}; exhaustive matching up to {args.spatial_above} views, spatial above. 'registers': at "
         f"least {REGISTERED_SHARE:.0%} of the views in the largest model. Centre error: the largest model's "
-        "mean after a similarity fit; relative rotation: median over pairs (large: the model folds).", "",
+        "mean after a similarity fit; relative rotation: median over pairs (large: the model folds). "
+        f"'right': registers with a mean centre error of at most {RIGHT_PCT_RADIUS:g} % of the scan radius.",
+        "",
         markdown_table(["planner", "size", "views", "registered", "models", "centre cm", "centre % R",
-                        "rel. rotation deg", "registers"], rows), "",
+                        "rel. rotation deg", "registers", "right"], rows), "",
         "## Smallest count that registers", "",
-        markdown_table(["planner", "size", "views"], found), ""])
+        markdown_table(["planner", "size", "registers", "registers right"], found), ""])
     write_text(args.out / "register_curve.md", text)
     write_json(args.out / "register_curve.json", {"commit": git_commit(), "command": command,
                                                   "scene": args.scene, "seed": args.seed, "spp": SPP,
@@ -173,7 +186,7 @@ def main(argv: list[str]) -> int:
     for count in sorted(args.counts):
         for planner in args.planners:
             for size in args.sizes:
-                if not args.all_counts and smallest(cases, planner, f"{size[0]}x{size[1]}") is not None:
+                if not args.all_counts and smallest(cases, planner, f"{size[0]}x{size[1]}", "right"):
                     continue
                 start = time.perf_counter()
                 if (planner, count) not in views:

@@ -26,6 +26,7 @@ Held-out buildings are refused: the curve is a measurement on the buildings the 
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import sys
 import time
@@ -113,8 +114,9 @@ def fmt(value: float | None, spec: str) -> str:
     return "-" if value is None else f"{value:{spec}}"
 
 
-def write_outputs(args: argparse.Namespace, cases: list[dict], command: str) -> None:
-    """register_curve.{json,md,png} from the cases so far."""
+def write_outputs(args: argparse.Namespace, cases: list[dict], command: str, commit: str) -> None:
+    """register_curve.{json,md,png} from the cases so far (`commit`: the code's at the start; each case
+    records its own, an earlier run's under --resume)."""
     sizes = [f"{w}x{h}" for w, h in args.sizes]
     rows = [[c["planner"], c["size"], str(c["count"]), f"{c['registered']}/{c['views']}", str(c["models"]),
              fmt(c["centre_error_cm"], ".1f"), fmt(c["centre_error_pct_radius"], ".1f"),
@@ -129,7 +131,7 @@ def write_outputs(args: argparse.Namespace, cases: list[dict], command: str) -> 
                 none = f"none up to {max(mine)}"
                 found.append([planner, size, *(none if n is None else str(n) for n in least)])
     text = "\n".join([
-        f"# Registration per view count and resolution: {args.scene} (commit {git_commit()})", "",
+        f"# Registration per view count and resolution: {args.scene} (commit {commit})", "",
         f"`{command}`", "",
         f"COLMAP (pycolmap, CPU, intrinsics fixed, seed {args.seed}) on each planner's views, rendered at "
         f"spp {SPP}; exhaustive matching up to {args.spatial_above} views, spatial above. 'registers': at "
@@ -142,7 +144,7 @@ def write_outputs(args: argparse.Namespace, cases: list[dict], command: str) -> 
         "## Smallest count that registers", "",
         markdown_table(["planner", "size", "registers", "registers right"], found), ""])
     write_text(args.out / "register_curve.md", text)
-    write_json(args.out / "register_curve.json", {"commit": git_commit(), "command": command,
+    write_json(args.out / "register_curve.json", {"commit": commit, "command": command,
                                                   "scene": args.scene, "seed": args.seed, "spp": SPP,
                                                   "registered_share": REGISTERED_SHARE, "cases": cases})
     plot(cases, args.out / "register_curve.png", args.scene)
@@ -173,6 +175,8 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--spatial-above", type=int, default=30, help="spatial matching above this count")
     parser.add_argument("--all-counts", action="store_true", help="do not stop at the first that registers")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--resume", action="store_true",
+                        help="reuse OUT/register_curve.json's cases (measured at the commit each records)")
     parser.add_argument("--out", type=Path, required=True)
     parser.add_argument("--work", type=Path, default=None, help="nbv sfm outputs (default OUT/runs)")
     args = parser.parse_args(argv)
@@ -181,6 +185,10 @@ def main(argv: list[str]) -> int:
     args.work = args.work or args.out / "runs"
     args.out.mkdir(parents=True, exist_ok=True)
     command = "python scripts/sfm_register_curve.py " + " ".join(argv)
+    commit = git_commit()
+    for planner in args.planners:  # each factory imported now, as at `commit`
+        make_planner(planner, PlanSettings(full_scan=False), args.seed)
+    done = previous(args.out / "register_curve.json") if args.resume else {}
     cases: list[dict] = []
     views: dict[tuple[str, int], list] = {}
     for count in sorted(args.counts):
@@ -188,16 +196,28 @@ def main(argv: list[str]) -> int:
             for size in args.sizes:
                 if not args.all_counts and smallest(cases, planner, f"{size[0]}x{size[1]}", "right"):
                     continue
-                start = time.perf_counter()
+                start, key = time.perf_counter(), (planner, count, f"{size[0]}x{size[1]}")
+                if key in done:
+                    cases.append(done[key])
+                    continue
                 if (planner, count) not in views:
                     views[(planner, count)] = plan_views(args.scene, planner, count, args.seed)
-                cases.append(run_case(args, planner, count, size, views[(planner, count)]))
+                found = run_case(args, planner, count, size, views[(planner, count)])
+                cases.append({**found, "commit": commit})
                 c = cases[-1]
                 print(f"{planner} {c['size']} {count}: {c['registered']}/{c['views']} in {c['models']} "
                       f"model(s), centre {fmt(c['centre_error_cm'], '.1f')} cm "
                       f"({time.perf_counter() - start:.0f} s)", flush=True)
-                write_outputs(args, cases, command)
+                write_outputs(args, cases, command, commit)
     return 0
+
+
+def previous(path: Path) -> dict[tuple[str, int, str], dict]:
+    """The cases of an earlier run's register_curve.json by (planner, count, size) ({} if none)."""
+    if not path.is_file():
+        return {}
+    doc = json.loads(path.read_text())
+    return {(c["planner"], c["count"], c["size"]): {"commit": doc["commit"], **c} for c in doc["cases"]}
 
 
 if __name__ == "__main__":

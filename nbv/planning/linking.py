@@ -3,11 +3,12 @@ docs/sfm.md §4): a candidate may be flown only if it shares at least K geometri
 (`nbv.sfm.links.verified_matches`) with a view already flown, so the flown set stays one connected match
 graph, as incremental structure from motion needs.
 
-Greedy, infogain and random apply it: each step they score their K candidates as before, and fly the best
-scoring of those linked to a flown view (random: the first linked); when none is linked, the candidate
-with the most matches to a flown view (the nearest to linked; first on ties). A candidate is matched with
-the `link_neighbours` flown views nearest it. With K = 0 none of this runs: the planners choose as before,
-bit-for-bit. Fixed patterns (circle, orbits, hemisphere), the policy and the oracle do not take it.
+Greedy, infogain and random apply it: each step they score their candidates (--candidates) as before,
+and fly the best scoring of those linked to a flown view (random: the first linked); when none is
+linked, the candidate with the most matches to a flown view (the nearest to linked; first on ties). A
+candidate is matched with the `link_neighbours` flown views nearest it; one at a viewpoint already
+flown is never flown again. With K = 0 none of this runs: the planners choose as before, bit-for-bit.
+Fixed patterns (circle, orbits, hemisphere), the policy and the oracle do not take it.
 """
 
 from __future__ import annotations
@@ -22,6 +23,9 @@ from nbv.sfm.config import LinkSettings
 from nbv.sfm.links import verified_matches
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 
+SAME_VIEW_M = 1e-6
+"""Camera centres closer than this are one viewpoint (greedy's and infogain's first candidate is the start
+view: both draw from the seed's generator first)."""
 ORIGIN = np.zeros(3)
 """The centre views are placed about to measure distances between them (any point does: only
 differences count)."""
@@ -74,9 +78,11 @@ class FlownLinks:
 
     def matches(self, view: Viewpoint, features: Features) -> int:
         """The most verified matches the candidate shares with one of its `link_neighbours` nearest flown
-        views."""
+        views; -1 for a candidate at a flown viewpoint (it would link, and add nothing: never flown)."""
         if not self.centres:
             return 0
         distance = np.linalg.norm(np.stack(self.centres) - viewpoint_to_c2w(view, ORIGIN)[:3, 3], axis=1)
+        if distance.min() < SAME_VIEW_M:
+            return -1
         nearest = np.argsort(distance, kind="stable")[: self.settings.link_neighbours]
         return max(verified_matches(features, self.features[i], self.K) for i in nearest)

@@ -13,11 +13,12 @@ from nbv.cli import main
 from nbv.features.config import FeatureConfig
 from nbv.features.sift import extract_features
 from nbv.planning.config import PlanConfig, PlanSettings
-from nbv.planning.linking import pick_linked
+from nbv.planning.linking import FlownLinks, pick_linked
 from nbv.sfm.config import LinkSettings
 from nbv.sfm.links import link_graph, verified_matches
 from nbv.sfm.repair import Repair, repair_kept, repair_links
 from render.dataset import read_dataset
+from render.viewpoint import Viewpoint
 from scenes.spec import SceneSpec
 
 ARC = {"views": 6, "step_deg": 15.0, "size": (240, 180)}
@@ -104,3 +105,14 @@ def test_min_matches_is_refused_for_a_planner_that_does_not_choose():
     with pytest.raises(ValueError, match=r"--min-matches applies to .*\(random, greedy, infogain\); 'orbit'"):
         PlanConfig(scene=SceneSpec(scene="test_building"), planner="orbit", out="x", settings=settings)
     PlanConfig(scene=SceneSpec(scene="test_building"), planner="greedy", out="x", settings=settings)
+
+
+def test_a_candidate_is_matched_with_the_flown_views_and_a_flown_viewpoint_never_again(features):
+    dataset, feats = features
+    flown = FlownLinks(LinkSettings(min_matches=K, link_neighbours=1), dataset.camera.K)
+    flown.add(Viewpoint(2.0, 0.0, 0.5), feats[0])
+    flown.add(Viewpoint(2.0, 3.0, 0.5), feats[3])
+    assert flown.matches(Viewpoint(2.0, 0.0, 0.5), feats[0]) == -1  # at a flown viewpoint
+    # near the first flown view, so matched with it alone (link_neighbours 1)
+    assert flown.matches(Viewpoint(2.0, 0.2, 0.5), feats[1]) == verified_matches(feats[1], feats[0],
+                                                                                  dataset.camera.K) >= K

@@ -70,7 +70,7 @@ def test_the_repair_takes_the_fewest_views_and_joins_every_kept_view():
     assert repair_links([], 3, {}, 9) == Repair([], [], [])
 
 
-def test_nbv_refine_with_min_matches_adds_the_views_between_two_kept(arc, tmp_path):
+def test_nbv_refine_with_min_matches_adds_the_views_between_two_kept(arc, tmp_path, capsys):
     common = ["--ranges", "1", "--words", "100", "--feature-backend", "opencv",
               "--cache-dir", str(tmp_path / "cache")]
     assert main(["refine", str(arc), "--out", str(tmp_path / "paper"), *common]) == 0
@@ -78,6 +78,8 @@ def test_nbv_refine_with_min_matches_adds_the_views_between_two_kept(arc, tmp_pa
     assert paper["kept"] == [0, 3] and "links" not in paper  # views 0 and 3 share about 10 matches
     args = ["--min-matches", str(K), "--link-neighbours", "5"]
     assert main(["refine", str(arc), "--out", str(tmp_path / "on"), *args, *common]) == 0
+    assert "registrable (--min-matches 100): the paper's rule kept 2, 2 added to link them, 0 kept view(s) " \
+           "unlinked" in capsys.readouterr().out
     doc = json.loads((tmp_path / "on" / "refine.json").read_text())
     assert doc["kept"] == [0, 1, 2, 3] and doc["kept_views"] == 4 and len(read_dataset(tmp_path / "on")) == 4
     links = doc["links"]

@@ -154,11 +154,14 @@ def plot(cases: list[dict], path: Path, scene: str) -> None:
     """Registered share against view count, one line per planner and size."""
     fig, ax = plt.subplots(figsize=(6, 4))
     for key in dict.fromkeys((c["planner"], c["size"]) for c in cases):
-        mine = sorted((c["count"], c["registered_share"]) for c in cases if (c["planner"], c["size"]) == key)
-        ax.plot(*zip(*mine), marker="o", label=f"{key[0]} {key[1]}")
+        mine = sorted((c["count"], c["registered_share"], c["right"]) for c in cases
+                      if (c["planner"], c["size"]) == key)
+        line, = ax.plot([m[0] for m in mine], [m[1] for m in mine], label=f"{key[0]} {key[1]}")
+        for count, share, right in mine:  # hollow: no model, or a wrong (folded) one
+            ax.plot(count, share, "o", color=line.get_color(), fillstyle="full" if right else "none")
     ax.axhline(REGISTERED_SHARE, color="grey", linestyle=":", linewidth=1)
     ax.set(xlabel="views", ylabel="share registered (largest model)", ylim=(-0.05, 1.05),
-           title=f"COLMAP registration: {scene}")
+           title=f"COLMAP registration: {scene} (filled: a right model)")
     ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
@@ -177,6 +180,8 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--resume", action="store_true",
                         help="reuse OUT/register_curve.json's cases (measured at the commit each records)")
+    parser.add_argument("--report-only", action="store_true",
+                        help="rewrite OUT/register_curve.{md,png} from its .json, running nothing")
     parser.add_argument("--out", type=Path, required=True)
     parser.add_argument("--work", type=Path, default=None, help="nbv sfm outputs (default OUT/runs)")
     args = parser.parse_args(argv)
@@ -184,6 +189,10 @@ def main(argv: list[str]) -> int:
         parser.error(f"{args.scene} is a held-out building; run the curve on a training building")
     args.work = args.work or args.out / "runs"
     args.out.mkdir(parents=True, exist_ok=True)
+    if args.report_only:
+        doc = json.loads((args.out / "register_curve.json").read_text())
+        write_outputs(args, doc["cases"], doc["command"], doc["commit"])
+        return 0
     command = "python scripts/sfm_register_curve.py " + " ".join(argv)
     commit = git_commit()
     for planner in args.planners:  # each factory imported now, as at `commit`

@@ -5,6 +5,11 @@ let only kept views update the vocabularies (docs/bov.md §5). The azimuth of
 a frame is its recorded viewpoint's, else the one computed from its pose about
 the dataset's centre. Features come from the on-disk cache, so a sweep over
 (N, W) extracts them once (`nbv.bov.sweep`).
+
+Beyond the paper, `--min-matches K` (`LinkSettings`, off by default) keeps the set registrable: the
+paper's kept set, then the fewest dropped views needed so every kept view is linked to the first through
+views sharing >= K verified SIFT matches (`nbv.sfm.repair`, docs/sfm.md §5); refine.json's `links`
+records the paper's set, the added and the unlinked views.
 """
 
 from __future__ import annotations
@@ -29,6 +34,8 @@ from nbv.bov.bag import BagOfViews
 from nbv.bov.config import BoVConfig, BoVRule
 from nbv.features.cache import dataset_features
 from nbv.features.sift import DESCRIPTOR_DIM, Features
+from nbv.sfm.config import LinkSettings
+from nbv.sfm.repair import repair_kept
 from render.captures.dataset import CaptureDataset
 from render.captures.frame import CaptureFrameConfig
 from render.captures.open import read_views, write_kept
@@ -38,6 +45,10 @@ from render.viewpoint import c2w_to_viewpoint
 FEATURE_BYTES = 2 * 4 * (DESCRIPTOR_DIM + 3)
 """Bytes one SIFT feature of a view takes while refining: float32 descriptor, keypoint and response, held
 twice (the per-view features and the cache file's concatenation)."""
+
+LINKS_NOTE = ("; with links (--min-matches): kept is the paper's kept set (links.paper_kept) plus "
+              "links.added, the dropped views that link every kept view to the first")
+"""What refine.json's note adds when the registrability repair ran."""
 
 Progress = Callable[[int], None]
 """Called with a count of work just done (e.g. a tqdm bar's `update`)."""
@@ -84,6 +95,9 @@ class RefineConfig(DatasetRun):
     """Folder for the refined dataset and refine.json."""
     bov: BoVConfig = BoVConfig()
     """The Bag of Views: N, W and the rule."""
+    links: LinkSettings = LinkSettings()
+    """Registrability (beyond the paper, off by default): with --min-matches K, the paper's kept set plus the
+    fewest dropped views that link every kept view to the first (`nbv.sfm.repair`)."""
     overwrite: bool = False
     """Replace the output folder if it is not empty."""
 
@@ -178,14 +192,19 @@ def refine_dataset(config: RefineConfig, progress: Progress | None = None) -> di
     dataset, feats, azimuths = load_views(config, config.bov, progress)
     result = refine_with(config.bov, [f.descriptors for f in feats], azimuths, config.bov.ranges,
                          config.bov.words, config.seed, config.device)
+    kept, links = result.kept, {}
+    if config.links.on:
+        repair, record = repair_kept(feats, dataset.poses()[:, :3, 3], dataset.camera.K, kept, config.links)
+        kept, links = repair.kept, {"links": record}
     settings = config.settings(config.bov)
-    summary = {"dataset": str(config.dataset), "source_views": len(dataset), "kept_views": len(result.kept),
-               "kept": result.kept, "scores": [_json_score(s) for s in result.scores],
-               "ranges": result.ranges, "settings": settings,
+    summary = {"dataset": str(config.dataset), "source_views": len(dataset), "kept_views": len(kept),
+               "kept": kept, "scores": [_json_score(s) for s in result.scores],
+               "ranges": result.ranges, "settings": settings, **links,
                "seconds": round(time.perf_counter() - start, 3),
-               "note": "scores: null is +inf (first view of an empty range); a view is kept iff score > 0",
+               "note": "scores: null is +inf (first view of an empty range); a view is kept iff score > 0"
+                       + (LINKS_NOTE if links else ""),
                **capture_record(dataset), **run_record("nbv refine", config)}
-    write_kept(dataset, result.kept, out, {"refine": {"source": str(config.dataset), **settings}},
+    write_kept(dataset, kept, out, {"refine": {"source": str(config.dataset), **settings}},
                config.overwrite, extra={"refine.json": summary})
     return summary
 

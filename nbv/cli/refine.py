@@ -20,4 +20,9 @@ def main(args: Sequence[str], prog: str) -> int:
         print(describe_frame(summary["capture"]))
     print(f"kept {summary['kept_views']} of {summary['source_views']} views "
           f"(N={config.bov.ranges}, W={config.bov.words}) in {summary['seconds']:.1f} s: {config.out}")
+    if "links" in summary:
+        links = summary["links"]
+        print(f"registrable (--min-matches {links['min_matches']}): the paper's rule kept "
+              f"{len(links['paper_kept'])}, {len(links['added'])} added to link them, "
+              f"{len(links['unlinked'])} kept view(s) unlinked")
     return 0

@@ -25,7 +25,7 @@ from __future__ import annotations
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -44,7 +44,7 @@ from nbv.planning.registry import tuned_planners
 from nbv.recon.heatmap import write_heatmap
 from nbv.recon.metrics import SurfaceMetrics, evaluate_surfaces
 from nbv.recon.tsdf import Reconstruction, reconstruct_dataset, save_reconstruction
-from nbv.sfm.config import SfmOption
+from nbv.sfm.config import LinkSettings, SfmOption
 from nbv.viz.figures import contact_sheet, plot_trajectory
 from render.dataset import ViewDataset, read_dataset
 from scenes.catalog import DEFAULT_SCENE
@@ -53,7 +53,8 @@ from scenes.model import Scene
 OUTPUTS = ("refined", "recon_full", "recon_refined", "contact_sheet.png", "trajectory_full.png",
            "trajectory_refined.png", "heatmap_refined_vs_full.png", "heatmap_refined_vs_full.ply",
            "heatmap_full_vs_gt.png", "heatmap_full_vs_gt.ply", "results.json", "results.md", "online_policy",
-           "online_random", *(f"online_{name}" for name in tuned_planners()), "sfm_full", "sfm_refined")
+           "online_random", *(f"online_{name}" for name in tuned_planners()), "sfm_full", "sfm_refined",
+           "refined_linked", "sfm_refined_linked")
 """What one demo run writes into `--out`, all together (the cached `full_scan/` beside them is kept)."""
 
 
@@ -68,6 +69,10 @@ class DemoConfig(FullScanStudy, SfmOption):
     """Built-in scene name, random:SEED, or a mesh path (with --up-axis)."""
     bov: BoVConfig = BoVConfig()
     """The Bag of Views of the refinement."""
+    links: LinkSettings = LinkSettings()
+    """With --min-matches K (beyond the paper): also the refinement kept registrable, refined_linked/ (the
+    paper's set plus the fewest views linking it), its view reduction beside the paper's rule and, with
+    --sfm, its registration."""
     fresh: bool = False
     """Rescan even if the output folder already holds a full scan made with these settings."""
     online: bool = True
@@ -117,6 +122,10 @@ def demo_stages(config: DemoConfig, scene: Scene, full: ViewDataset, folder: Pat
         refine = RefineConfig(dataset=full.root, out=folder / "refined", bov=config.bov, seed=config.seed,
                               overwrite=True)
         refined = refine_dataset(refine, progress)
+    linked = None
+    if config.links.on:
+        with clock.stage("refine_linked_s"):
+            linked = refine_dataset(replace(refine, out=folder / "refined_linked", links=config.links))
     with clock.stage("reconstruct_s"):
         recon_full = reconstruct_dataset(full, config.recon)
         recon_refined = reconstruct_dataset(full, config.recon, refined["kept"])
@@ -132,7 +141,7 @@ def demo_stages(config: DemoConfig, scene: Scene, full: ViewDataset, folder: Pat
         }
     with clock.stage("figures_s"):
         figures = draw_figures(config, scene.name, full, recon_full, recon_refined, gt, folder)
-    sfm = sfm_stage(config, full, folder, clock) if config.sfm else {}
+    sfm = sfm_stage(config, full, folder, clock, linked is not None) if config.sfm else {}
     online = {}
     if config.online:
         with clock.stage("online_s"):
@@ -144,6 +153,7 @@ def demo_stages(config: DemoConfig, scene: Scene, full: ViewDataset, folder: Pat
         "views_full": len(full),
         "views_refined": len(refined["kept"]),
         "kept": refined["kept"],
+        **({} if linked is None else {"views_refined_linked": len(linked["kept"]), "links": linked["links"]}),
         "metrics": {name: {ref: m.as_dict() for ref, m in per.items()} for name, per in metrics.items()},
         "timings": clock.seconds,
         "figures": {k: str(out / Path(v).name) for k, v in figures.items()},
@@ -153,14 +163,19 @@ def demo_stages(config: DemoConfig, scene: Scene, full: ViewDataset, folder: Pat
     return results, results_table(results, metrics)
 
 
-def sfm_stage(config: DemoConfig, full: ViewDataset, folder: Path, clock: Stopwatch) -> dict[str, Any]:
-    """COLMAP on the full scan and on the refined set (`folder/refined`) into `folder/sfm_full` and
-    `folder/sfm_refined`; each set's headline (`nbv.sfm.check.sfm_summary`)."""
+def sfm_stage(config: DemoConfig, full: ViewDataset, folder: Path, clock: Stopwatch,
+              linked: bool = False) -> dict[str, Any]:
+    """COLMAP on the full scan, on the refined set (`folder/refined`) and, with `linked`, on the registrable
+    one (`folder/refined_linked`) into `folder/sfm_full`, `sfm_refined`, `sfm_refined_linked`; each set's
+    headline (`nbv.sfm.check.sfm_summary`)."""
     from nbv.sfm.check import sfm_summary  # pycolmap only when asked for
 
     record = run_record("nbv demo", config)
     found = {}
-    for name, dataset in (("full", full), ("refined", read_dataset(folder / "refined"))):
+    sets = [("full", full), ("refined", read_dataset(folder / "refined"))]
+    if linked:
+        sets.append(("refined_linked", read_dataset(folder / "refined_linked")))
+    for name, dataset in sets:
         with clock.stage(f"sfm_{name}_s"):
             found[name] = sfm_summary(dataset, config.sfm_settings, config.seed, folder / f"sfm_{name}",
                                       record)
@@ -231,6 +246,7 @@ def results_table(results: dict[str, Any], metrics: dict[str, dict[str, SurfaceM
         f"{min(paper_chamfer):.2f} to {max(paper_chamfer):.2f} cm, Hausdorff {min(paper_hausdorff):.2f} to "
         f"{max(paper_hausdorff):.2f} cm; its summary: {SEC7_SUMMARY['fewer_views_pct']} % fewer views and "
         f"{SEC7_SUMMARY['lower_error_pct']} % lower error (Sec. VII).",
+        *linked_lines(results),
         "",
         "Timings (s): " + ", ".join(f"{k} {v}" for k, v in results["timings"].items()),
         "",
@@ -251,14 +267,27 @@ def results_table(results: dict[str, Any], metrics: dict[str, dict[str, SurfaceM
     return "\n".join(lines + sfm_lines(results))
 
 
+def linked_lines(results: dict[str, Any]) -> list[str]:
+    """With --min-matches, the registrable refinement's view reduction beside the paper's rule; else none."""
+    if "links" not in results:
+        return []
+    links, full = results["links"], results["views_full"]
+    paper, linked = len(links["paper_kept"]), results["views_refined_linked"]
+    return [f"Registrable refinement (--min-matches {links['min_matches']}, beyond the paper): kept {linked} "
+            f"of {full} views ({100 * (1 - linked / full):.1f} % fewer), the paper's rule's {paper} "
+            f"({100 * (1 - paper / full):.1f} % fewer) plus {len(links['added'])} linking views; "
+            f"{len(links['unlinked'])} kept view(s) unlinked (refined_linked/)."]
+
+
 def sfm_lines(results: dict[str, Any]) -> list[str]:
     """With --sfm, the demo's structure-from-motion table: the full and the refined set, then the online
     half's runs; else none."""
     if "sfm" not in results:
         return []
-    sets = {f"{name} set": doc for name, doc in results["sfm"].items()}
+    sets = {f"{name.replace('_', ' ')} set": doc for name, doc in results["sfm"].items()}
     sets.update({f"online {name}": run["sfm"] for name, run in results["online"].items()})
     rows = [[name, *sfm_cells([sfm_entry(doc)])] for name, doc in sets.items()]
     return ["## Structure from motion (COLMAP): views registered in the largest model, models, its mean "
-            "camera-centre error after a similarity fit (sfm_full/, sfm_refined/, online_*/sfm/)", "",
+            "camera-centre error after a similarity fit (sfm_full/, sfm_refined/, sfm_refined_linked/ with "
+            "--min-matches, online_*/sfm/)", "",
             markdown_table(["view set", *SFM_HEADER], rows), ""]

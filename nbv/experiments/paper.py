@@ -33,6 +33,7 @@ from nbv.experiments.table2 import TablesConfig, run_tables
 from nbv.planning.config import PlanSettings
 from nbv.planning.registry import budget_planners
 from nbv.recon.config import MetricsConfig, OccupancyConfig
+from nbv.sfm.config import SfmOption
 from nbv.viz.paper import plot_episodes
 from render.camera import UAVCamera
 from render.scan import HemispherePlan
@@ -49,8 +50,9 @@ SEC7_OUTPUTS = ("sec7.md", "sec7.json")
 
 
 @dataclass(frozen=True, kw_only=True)
-class PaperConfig(TablesConfig):
-    """Settings of `nbv tables` (`--quick` starts from `QUICK` instead of these defaults)."""
+class PaperConfig(TablesConfig, SfmOption):
+    """Settings of `nbv tables` (`--quick` starts from `QUICK` instead of these defaults; --sfm: the budget
+    part's plans also run structure from motion, and budget.md gains the registration columns)."""
 
     part: Annotated[tuple[Part, ...], UseAppendAction] = ()
     """Run only these parts (repeat --part; default: all): table2, sec7 (needs table2's files), episodes,
@@ -220,7 +222,7 @@ def budget_config(config: PaperConfig) -> BudgetConfig:
     return BudgetConfig(out=Path(config.out) / "budget", scenes=config.held_out,
                         planners=tuple(config.policy if p == "policy" else p for p in config.planners),
                         seeds=config.seeds, budgets=config.budgets, settings=budget_settings(config),
-                        executor=config.executor)
+                        executor=config.executor, sfm=config.sfm, sfm_settings=config.sfm_settings)
 
 
 def run_paper(config: PaperConfig, progress: Progress | None = None,
@@ -282,6 +284,8 @@ INDEX = (
            "term in the reward", "scripts/select_defaults.py --round 4"),
     Result("selection/round1/selection.md", "selection/round1/selection.json", "its first round, before the "
            "lattice fix", "scripts/select_defaults.py --round 1"),
+    Result("sfm/register_curve.md", "sfm/register_curve.json", "COLMAP registration per view count and "
+           "resolution: the policy, the tuned orbit, random views", "scripts/sfm_register_curve.py"),
     Result("captures/captures.md", "captures/captures.json", "the full scan as COLMAP and nerfstudio "
            "captures: kept-frame Jaccard against the scan's own", "scripts/capture_agreement.py"),
 )

@@ -22,7 +22,7 @@ import numpy as np
 import torch
 
 from common.threads import apply_thread_policy
-from nbv.features.sift import FeatureConfig, extract_features
+from nbv.features.sift import FeatureConfig, Features, extract_features
 from render.camera import UAVCamera
 from render.renderer import MitsubaRenderer
 from render.settings import RenderSettings
@@ -120,6 +120,13 @@ class ViewSource:
         """The SIFT descriptors (M, 128) of an image."""
         apply_thread_policy()  # here: in the process that extracts, before Kornia picks its threads
         return torch.as_tensor(extract_features([rgb], self.features)[0].descriptors)
+
+    def features_at(self, view: Viewpoint) -> Features:
+        """The SIFT features (keypoints and descriptors) of the RGB image rendered at `view`: the same
+        render and descriptors `capture` gives, for a planner that also matches views
+        (`nbv.planning.linking`)."""
+        apply_thread_policy()
+        return extract_features([self.render_rgb(view)], self.features)[0]
 
     def capture(self, view: Viewpoint) -> tuple[np.ndarray, torch.Tensor]:
         """The grayscale frame (`frame_size` squared, uint8) and SIFT descriptors (M, 128) rendered at

@@ -15,9 +15,9 @@ from tyro.conf import arg
 
 from common.memory import check_memory
 from nbv.bov.config import BoVConfig
-from nbv.planning.registry import entry, planner_help
+from nbv.planning.registry import entries, entry, planner_help
 from nbv.recon.config import MetricsConfig, OccupancyConfig, ReconstructionConfig
-from nbv.sfm.config import SfmOption
+from nbv.sfm.config import LinkSettings, SfmOption
 from render.camera import UAVCamera
 from render.scan import check_views
 from render.settings import RenderSettings
@@ -42,6 +42,9 @@ class PlanSettings:
     """Greedy, oracle and infogain planners: candidate viewpoints per step (only greedy renders them)."""
     occupancy: OccupancyConfig = OccupancyConfig()
     """The infogain planner's occupancy grid."""
+    links: LinkSettings = LinkSettings()
+    """Registrability of the flown set (beyond the paper, off by default): random, greedy and infogain fly
+    only candidates sharing >= --min-matches verified matches with a view flown (`nbv.planning.linking`)."""
     reference: Path | None = None
     """Reference mesh (full-scan reconstruction); default: reconstruct the hemisphere scan, cached."""
     full_scan: bool = True
@@ -86,4 +89,8 @@ class PlanConfig(SfmOption):
                          camera.width * camera.height * VIEW_PIXEL_BYTES, "plan fewer --views")
         if self.seed < 0:
             raise ValueError(f"seed must be >= 0, got {self.seed}")
-        entry(self.planner)  # an unknown planner fails here, naming every one
+        found = entry(self.planner)  # an unknown planner fails here, naming every one
+        if self.settings.links.on and "links" not in found.settings:
+            takes = ", ".join(e.name for e in entries() if "links" in e.settings)
+            raise ValueError(f"--min-matches applies to the planners that choose among candidates ({takes}); "
+                             f"{self.planner!r} does not: leave --min-matches at 0 for it")

@@ -16,7 +16,9 @@ padded by a margin (the region of interest these methods are given; the env
 already aims every view at its centre) and is updated with the z-depth image the
 camera returns at each view flown to (`ViewSource.render_depth`). Candidates are
 not rendered: their gain is ray cast through the grid, and no RGB image is
-rendered at all. No appearance, no model.
+rendered at all. No appearance, no model. With `--min-matches K` (beyond the paper;
+`nbv.planning.linking`) candidates are also rendered and matched, and only those linked to a flown view
+may be flown.
 """
 
 from __future__ import annotations
@@ -26,8 +28,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from nbv.planning.base import Planner, check_candidates, sample_viewpoints
+from nbv.planning.linking import FlownLinks, pick_linked
 from nbv.recon.config import OccupancyConfig
 from nbv.recon.occupancy import OccupancyGrid
+from nbv.sfm.config import LinkSettings
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes.model import Scene
 
@@ -59,28 +63,41 @@ class InfoGainPlanner(Planner):
     name = "infogain"
 
     def __init__(self, candidates: int = 8, seed: int = 0, grid: OccupancyConfig = OccupancyConfig(),
-                 default_views: int = 13) -> None:
+                 default_views: int = 13, links: LinkSettings = LinkSettings()) -> None:
         self.candidates = check_candidates("infogain", candidates)
-        self.seed, self.grid, self.default_views = seed, grid, default_views
+        self.seed, self.grid, self.default_views, self.links = seed, grid, default_views, links
 
     def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
-        """The start view, then `views - 1` moves, each to the candidate of highest gain."""
+        """The start view, then `views - 1` moves, each to the candidate of highest gain; with `links` on
+        (--min-matches K, beyond the paper), of highest gain among those linked to a flown view (the
+        candidates' RGB images rendered to match them; `nbv.planning.linking`)."""
         rng = np.random.default_rng(self.seed)
         scene, camera = world.target, world.camera
         grid, center = target_grid(scene, self.grid), scene.center()
         view = world.start
         chosen = [view]
+        flown = FlownLinks(self.links, camera.K) if self.links.on else None
+        if flown is not None:
+            flown.add(view, world.source.features_at(view))
         for _ in range((self.default_views if views is None else views) - 1):
             grid.integrate(world.source.render_depth(view), camera.K, viewpoint_to_c2w(view, center),
                            self.grid.integrate_ray_stride)
             candidates = sample_viewpoints(world.low, world.high, self.candidates, rng)
             gains = [grid.gain(camera.K, viewpoint_to_c2w(c, center), camera.width, camera.height,
                                self.grid.gain_ray_stride) for c in candidates]
-            view = candidates[int(np.argmax(gains))]
+            if flown is None:
+                view = candidates[int(np.argmax(gains))]
+            else:
+                looked = [world.source.features_at(c) for c in candidates]
+                links = [flown.matches(c, f) for c, f in zip(candidates, looked, strict=True)]
+                k = pick_linked(gains, links, self.links.min_matches)
+                view = candidates[k]
+                flown.add(view, looked[k])
             chosen.append(view)
         return chosen
 
 
 def infogain_planner(settings: PlanSettings, seed: int, checkpoint: str | None) -> InfoGainPlanner:
-    """The registry's `infogain`: K = `settings.candidates`, the grid of `settings.occupancy`."""
-    return InfoGainPlanner(settings.candidates, seed, settings.occupancy)
+    """The registry's `infogain`: K = `settings.candidates`, the grid of `settings.occupancy`, registrability
+    `settings.links`."""
+    return InfoGainPlanner(settings.candidates, seed, settings.occupancy, links=settings.links)

@@ -24,6 +24,8 @@ planners by name in `registry.py`.
   coverage of the true surface, of every other budget planner's views and its
   own greedy pick; it uses the ground-truth mesh, so it is an upper-bound
   reference of those planners, not a planner a real UAV could run.
+- Registrability (`--min-matches K`, beyond the paper; `linking.py`): random, greedy and infogain fly
+  only candidates sharing >= K verified matches with a view flown (off by default, as before).
 - `PolicyPlanner` (`policy.py`): a trained SAC actor from the start view, acting on
   its distribution's mode (`policy:CHECKPOINT`, deterministic) or on seeded
   draws from it (`policy-sample:CHECKPOINT`, the max-entropy policy SAC
@@ -32,32 +34,55 @@ planners by name in `registry.py`.
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from nbv.planning.base import Planner, check_candidates, sample_viewpoints
+from nbv.planning.linking import FlownLinks, first_best, pick_linked
+from nbv.sfm.config import LinkSettings
 from render.scan import HemispherePlan, hemisphere_scan
 from render.viewpoint import TWO_PI, Viewpoint
 
 if TYPE_CHECKING:
+    import torch
+
+    from nbv.features.sift import Features
+    from nbv.features.source import ViewSource
     from nbv.planning.config import PlanSettings
     from nbv.planning.world import PlanningWorld
 
 
 class RandomPlanner(Planner):
-    """Uniformly random viewpoints in the allowed ranges (seeded)."""
+    """Uniformly random viewpoints in the allowed ranges (seeded). With `links` on (--min-matches K, beyond
+    the paper; `nbv.planning.linking`): each view after the first is the first of `candidates` draws
+    linked to a view flown (rendered to match them)."""
 
     name = "random"
 
-    def __init__(self, seed: int = 0, default_views: int = 13) -> None:
-        self.seed, self.default_views = seed, default_views
+    def __init__(self, seed: int = 0, default_views: int = 13, links: LinkSettings = LinkSettings(),
+                 candidates: int = 8) -> None:
+        self.seed, self.default_views, self.links = seed, default_views, links
+        self.candidates = check_candidates("random", candidates)
 
     def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """`views` (default 13, the paper's Fig. 1 count) random viewpoints."""
         count = self.default_views if views is None else views
-        return sample_viewpoints(world.low, world.high, count, np.random.default_rng(self.seed))
+        rng = np.random.default_rng(self.seed)
+        if not self.links.on:
+            return sample_viewpoints(world.low, world.high, count, rng)
+        flown = FlownLinks(self.links, world.camera.K)
+        chosen = sample_viewpoints(world.low, world.high, min(count, 1), rng)
+        for view in chosen:
+            flown.add(view, world.source.features_at(view))
+        for _ in range(count - len(chosen)):
+            candidates = sample_viewpoints(world.low, world.high, self.candidates, rng)
+            looked = [world.source.features_at(view) for view in candidates]
+            links = [flown.matches(view, f) for view, f in zip(candidates, looked, strict=True)]
+            k = pick_linked([0.0] * len(candidates), links, self.links.min_matches)
+            flown.add(candidates[k], looked[k])
+            chosen.append(candidates[k])
+        return chosen
 
 
 class CirclePlanner(Planner):
@@ -94,31 +119,52 @@ class GreedyBoVPlanner(Planner):
 
     name = "greedy"
 
-    def __init__(self, candidates: int = 8, seed: int = 0, default_views: int = 13) -> None:
+    def __init__(self, candidates: int = 8, seed: int = 0, default_views: int = 13,
+                 links: LinkSettings = LinkSettings()) -> None:
         self.candidates = check_candidates("greedy", candidates)
-        self.seed, self.default_views = seed, default_views
+        self.seed, self.default_views, self.links = seed, default_views, links
 
     def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
-        """The start view, then `views - 1` greedy moves (default 13 views in all)."""
+        """The start view, then `views - 1` greedy moves (default 13 views in all); with `links` on
+        (--min-matches K, beyond the paper), each move to the best candidate linked to a flown view
+        (`nbv.planning.linking`)."""
         rng = np.random.default_rng(self.seed)
         source, bov, start = world.source, world.bov, world.start
-        bov.update(source.capture(start)[1], start.azimuth, start.elevation)  # as the env learns its first
+        flown = FlownLinks(self.links, world.camera.K) if self.links.on else None
+        descriptors, features = look(source, start, flown)
+        bov.update(descriptors, start.azimuth, start.elevation)  # as the env learns its first
         chosen = [start]
+        if flown is not None:
+            flown.add(start, features)
         for _ in range((self.default_views if views is None else views) - 1):
-            best, best_reward, best_descriptors = None, -math.inf, None
-            for view in sample_viewpoints(world.low, world.high, self.candidates, rng):
-                _, descriptors = source.capture(view)
-                reward = bov.reward(descriptors, view.azimuth, view.elevation, commit=False)
-                if reward > best_reward:
-                    best, best_reward, best_descriptors = view, reward, descriptors
-            bov.update(best_descriptors, best.azimuth, best.elevation)
-            chosen.append(best)
+            candidates = sample_viewpoints(world.low, world.high, self.candidates, rng)
+            looked = [look(source, view, flown) for view in candidates]
+            rewards = [bov.reward(d, view.azimuth, view.elevation, commit=False)
+                       for view, (d, _) in zip(candidates, looked, strict=True)]
+            if flown is None:
+                k = first_best(rewards)
+            else:
+                links = [flown.matches(view, f) for view, (_, f) in zip(candidates, looked, strict=True)]
+                k = pick_linked(rewards, links, self.links.min_matches)
+                flown.add(candidates[k], looked[k][1])
+            bov.update(looked[k][0], candidates[k].azimuth, candidates[k].elevation)
+            chosen.append(candidates[k])
         return chosen
 
 
+def look(source: ViewSource, view: Viewpoint,
+         flown: FlownLinks | None) -> tuple[torch.Tensor, Features | None]:
+    """A candidate's descriptors, rendered as `capture` renders them, and its features when views are
+    matched (`flown`), else None."""
+    if flown is None:
+        return source.capture(view)[1], None
+    features = source.features_at(view)
+    return features.descriptors, features
+
+
 def random_planner(settings: PlanSettings, seed: int, checkpoint: str | None) -> RandomPlanner:
-    """The registry's `random`."""
-    return RandomPlanner(seed)
+    """The registry's `random` (with --min-matches: K = `settings.candidates` draws per view)."""
+    return RandomPlanner(seed, links=settings.links, candidates=settings.candidates)
 
 
 def circle_planner(settings: PlanSettings, seed: int, checkpoint: str | None) -> CirclePlanner:
@@ -132,5 +178,5 @@ def hemisphere_planner(settings: PlanSettings, seed: int, checkpoint: str | None
 
 
 def greedy_planner(settings: PlanSettings, seed: int, checkpoint: str | None) -> GreedyBoVPlanner:
-    """The registry's `greedy`: K = `settings.candidates`."""
-    return GreedyBoVPlanner(settings.candidates, seed)
+    """The registry's `greedy`: K = `settings.candidates`, registrability `settings.links`."""
+    return GreedyBoVPlanner(settings.candidates, seed, links=settings.links)

@@ -67,7 +67,7 @@ class PlannerEntry:
 
 PLANNERS: tuple[PlannerEntry, ...] = (
     PlannerEntry("random", "viewpoints uniform in the allowed ranges (seeded)",
-                 "nbv.planning.planners:random_planner", compared=True),
+                 "nbv.planning.planners:random_planner", settings=("links", "candidates"), compared=True),
     PlannerEntry("circle", "evenly spaced azimuths at the middle radius and elevation",
                  "nbv.planning.planners:circle_planner", prefixes=False, compared=True),
     PlannerEntry("orbit", "one ring: evenly spaced azimuths from the start view's azimuth at a fixed radius "
@@ -82,13 +82,14 @@ PLANNERS: tuple[PlannerEntry, ...] = (
                  tuned=True),
     PlannerEntry("greedy", "greedy Bag of Views: from the start view, render K (--candidates) random "
                  "candidates per step, move to the one of highest Bag of Views reward (no learning)",
-                 "nbv.planning.planners:greedy_planner", settings=("candidates", "bov"), compared=True),
+                 "nbv.planning.planners:greedy_planner", settings=("candidates", "bov", "links"),
+                 compared=True),
     PlannerEntry("hemisphere", "the full hemisphere scan at the middle radius (288 views with the default "
                  "camera)", "nbv.planning.planners:hemisphere_planner", prefixes=False, budget=False),
     PlannerEntry("infogain", "volumetric information gain (model-free, from depth): move to the one of K "
                  "random candidates (greedy's stream) that would see the most unknown voxels of an occupancy "
                  "grid carved from the depth of the views flown to",
-                 "nbv.planning.infogain:infogain_planner", settings=("candidates", "occupancy")),
+                 "nbv.planning.infogain:infogain_planner", settings=("candidates", "occupancy", "links")),
     PlannerEntry("policy", "a trained actor (a `nbv train` checkpoint.pt or policy.pt; none: the shipped "
                  "policy) from the start view, acting on its distribution's mode",
                  "nbv.planning.policy:policy_planner", checkpoint=True),

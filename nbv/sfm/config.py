@@ -43,6 +43,33 @@ class SfmSettings:
             raise ValueError(f"colmap_threads must be >= 0 (0: the usable cores), got {self.colmap_threads}")
 
 
+@dataclass(frozen=True)
+class LinkSettings:
+    """Registrability as a constraint of refinement and planning (beyond the paper; docs/sfm.md §5): a view
+    is kept or flown only if it shares enough geometrically verified SIFT matches with one already kept or
+    flown, so the set stays one connected match graph, as incremental structure from motion needs."""
+
+    min_matches: int = 0
+    """K: a view is kept (`nbv refine`: the paper's kept set, then the fewest dropped views that link every
+    kept view to the first) or flown (greedy, infogain, random: among the candidates linked to a flown
+    view) only if it shares at least K verified matches with one kept or flown (nbv.sfm.links); 0: off,
+    the paper's rule and the planners as before, bit-for-bit."""
+    link_neighbours: int = 8
+    """With --min-matches: a view is matched only with this many views nearest it by camera centre (the
+    pairs of the match graph; keeps the matching cheap)."""
+
+    def __post_init__(self) -> None:
+        if self.min_matches < 0:
+            raise ValueError(f"min_matches must be >= 0 (0: off), got {self.min_matches}")
+        if self.link_neighbours < 1:
+            raise ValueError(f"link_neighbours must be >= 1, got {self.link_neighbours}")
+
+    @property
+    def on(self) -> bool:
+        """Whether the constraint applies (K > 0)."""
+        return self.min_matches > 0
+
+
 @dataclass(frozen=True, kw_only=True)
 class SfmOption:
     """Whether a command that captures view sets (`nbv plan`, the planner studies, the demo) also runs

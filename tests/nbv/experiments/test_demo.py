@@ -34,7 +34,7 @@ def test_demo_runs_every_stage_and_reuses_its_scan(tmp_path, capsys):
     args = ["demo", "--out", str(out), "--scene", "test_building", "--width", "96", "--height", "72",
             "--spp", "2", "--end-overlap", "0.5", "--side-overlap", "0.4", "--ranges", "3", "--words", "5",
             "--voxel-size-m", "0.01", "--metric-points", "5000", "--online-scene", "test_building",
-            "--policy", untrained_policy(tmp_path / "run")]
+            "--policy", untrained_policy(tmp_path / "run"), "--min-matches", "15"]
     tmp_path = out
     assert main(args) == 0
     printed = capsys.readouterr().out
@@ -52,6 +52,12 @@ def test_demo_runs_every_stage_and_reuses_its_scan(tmp_path, capsys):
         assert (tmp_path / f"{results['figures'][name].split('/')[-1]}").stat().st_size > 0
     for sub in ("recon_full/mesh.ply", "recon_refined/points.ply", "refined/refine.json"):
         assert (tmp_path / sub).is_file()
+    links = results["links"]  # --min-matches: the registrable refinement beside the paper's rule
+    assert links["paper_kept"] == results["kept"] and links["min_matches"] == 15
+    linked = json.loads((tmp_path / "refined_linked" / "refine.json").read_text())["kept"]
+    assert sorted(set(results["kept"]) | set(links["added"])) == linked
+    assert results["views_refined_linked"] == len(linked) and "refine_linked_s" in results["timings"]
+    assert f"Registrable refinement (--min-matches 15, beyond the paper): kept {len(linked)} of" in printed
     stamp = (tmp_path / "full_scan" / "transforms.json").stat().st_mtime_ns
     online = results["online"]
     assert 2 <= online["policy"]["views"] <= 4 and online["random"]["views"] == online["policy"]["views"]

@@ -1,6 +1,7 @@
-"""--sfm in the planner studies and the demo: the flag reaches every run a study command makes and keys
-when a run counts as done; the tables gain the registration columns (from recorded SfM results); the
-demo's SfM stage runs COLMAP for real on a tiny textured-box scan (`synthetic_box`)."""
+"""--sfm in the planner studies, the demo and `nbv tables` (its budget part): the flag reaches every run a
+study command makes and keys when a run counts as done; the tables gain the registration columns (from
+recorded SfM results); the demo's SfM stage runs COLMAP for real on a tiny textured-box scan
+(`synthetic_box`)."""
 
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ from nbv.experiments.budget import BudgetConfig
 from nbv.experiments.compare import CompareConfig, compare_planners
 from nbv.experiments.demo import DemoConfig, Stopwatch, online_study, sfm_lines, sfm_stage
 from nbv.experiments.online import OnlineConfig, comparisons, run_online
+from nbv.experiments.paper import PaperConfig, budget_config
 from nbv.experiments.planner_study import StudyRun, plan_units
 from nbv.experiments.sfm_columns import planned_sfm_table
 from render.dataset import read_dataset
@@ -27,6 +29,7 @@ STUDIES = {
                lambda c: [task for one in comparisons(c) for task in plan_units(one.study())]),
     "budget": (BudgetConfig, [], lambda c: plan_units(c.study(Path("runs")))),
     "demo": (DemoConfig, [], lambda c: plan_units(online_study(c, Path("demo"), "policy", c.policy, None))),
+    "tables": (PaperConfig, [], lambda c: plan_units(budget_config(c).study(Path("runs")))),
 }
 """Per study command: its config, the arguments it needs and the plan units it makes."""
 
@@ -111,3 +114,5 @@ def test_the_demo_sfm_stage_reconstructs_the_full_and_the_refined_set(tmp_path):
     assert [row.split(" | ")[:3] for row in rows] == [["| full set", "6/6", "1.0"],
                                                       ["| refined set", "6/6", "1.0"]]
     assert sfm_lines({"online": {}}) == []
+    linked = sfm_lines({"sfm": {"refined_linked": found["refined"]}, "online": {}})[2].splitlines()[2]
+    assert linked.startswith("| refined linked set | 6/6 |")

@@ -218,6 +218,7 @@ def main(argv: list[str]) -> int:
                       f"model(s), centre {fmt(c['centre_error_cm'], '.1f')} cm "
                       f"({time.perf_counter() - start:.0f} s)", flush=True)
                 write_outputs(args, cases, command, commit)
+    write_outputs(args, cases, command, commit)  # the cases reused from --resume after the last one run
     return 0
 
 

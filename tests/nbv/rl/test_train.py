@@ -232,7 +232,8 @@ def test_a_record_from_before_the_reward_group_reads_into_it():
     current = config_record(replace(tiny("run", 4), reward=RewardConfig(coverage=30.0)))
     old = old_layout(current)
     assert old["env"]["coverage_reward"] == 30.0 and "reward" not in old
-    assert upgrade_record(old) == current and with_defaults(old) == current
+    assert with_defaults(old) == current  # the groups' later fields (the flight term) take their defaults
+    assert upgrade_record(old)["reward"] == {"coverage": 30.0}
     assert upgrade_record(current) == current  # today's records come back equal
     assert old["env"]["coverage_reward"] == 30.0  # the record read is left as it was
 
@@ -248,7 +249,7 @@ def test_shipped_records_read_into_the_reward_and_members_groups():
     assert config["reward"] == {"coverage": 100.0} and config["members"] == {"count": 3}
     assert "coverage_reward" not in config["env"] and "members" not in config["validation"]
     recorded = json.loads((Path(SHIPPED_POLICY).parent / "config.json").read_text())
-    assert with_defaults(recorded)["reward"] == {"coverage": 100.0}
+    assert with_defaults(recorded)["reward"] == {"coverage": 100.0, "flight": 0.0}
     parsed = config_from_record(TrainConfig, config)
     assert parsed.reward.coverage == 100.0 and parsed.members.count == 3
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import hashlib
 from dataclasses import replace
 
 import numpy as np
@@ -17,21 +16,14 @@ from scenes.model import Material
 from scenes.presets import PRESETS
 from scenes.surface import make_part, planar_uv
 from scenes.textures import texture_path
+from tests.scene_bytes import scene_bytes_digest
 
 SMALL = replace(PRESETS["alpine_chalet"], width=8.0, depth=6.0, storeys=1, wall_roles=("stone_walls",),
                 balcony_storeys=(), chimneys=0)
 """A one-storey chalet: every role of a preset, built in about a second."""
 SMALL_TILED_DIGEST = "aab2d65b5231933d"
-"""`_digest` of `build_building("small", SMALL)` at a127bd7, before surface detail existed."""
-
-
-def _digest(scene) -> str:
-    h = hashlib.sha256()
-    for p in scene.parts:
-        h.update(p.vertices.tobytes() + p.faces.tobytes() + (p.uv.tobytes() if p.uv is not None else b""))
-        if p.material.texture is not None:
-            h.update(p.material.texture.read_bytes())
-    return h.hexdigest()[:16]
+"""`scene_bytes_digest` (first 16 hex digits) of `build_building("small", SMALL)` at a127bd7, before
+surface detail existed."""
 
 
 def _box_walls() -> np.ndarray:
@@ -89,7 +81,7 @@ def test_detail_is_seeded_and_its_name_does_not_depend_on_the_cache_folder(tmp_p
 
 def test_tiled_flag_restores_the_old_textures_bit_exactly_and_keys_differ():
     tiled, detailed = build_building("small", SMALL, detail=False), build_building("small", SMALL)
-    assert _digest(tiled) == SMALL_TILED_DIGEST
+    assert scene_bytes_digest(tiled)[:16] == SMALL_TILED_DIGEST
     assert [p.name for p in tiled.parts] == [p.name for p in detailed.parts]
     for a, b in zip(tiled.parts, detailed.parts):
         assert np.array_equal(np.unique(a.vertices, axis=0), np.unique(b.vertices, axis=0))

@@ -135,9 +135,14 @@ def check_separate(out: str | Path, source: str | Path, may_hold: bool = False) 
         raise ValueError(f"out {out} holds the input folder {source}: replacing it would delete the input")
 
 
+PF_EXITING = 0x4
+"""The kernel's per-process flag of a process in exit (`/proc/PID/stat` field 9): set before the dying
+process closes its files, so before a parent (a Ray raylet) can see its sockets close."""
+
+
 def _pid_alive(pid: int) -> bool:
-    """Whether process `pid` still runs: a killed worker its parent has not reaped yet (a zombie, which
-    signal 0 still reaches) is dead."""
+    """Whether process `pid` still runs: a killed worker still tearing down (PF_EXITING) or not yet reaped
+    by its parent (a zombie, which signal 0 still reaches) is dead."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
@@ -145,10 +150,11 @@ def _pid_alive(pid: int) -> bool:
     except PermissionError:
         return True
     try:
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-    except (OSError, IndexError):
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        state, flags = fields[0], int(fields[6])
+    except (OSError, IndexError, ValueError):
         return True
-    return state not in ("Z", "X")
+    return state not in ("Z", "X") and not flags & PF_EXITING
 
 
 def recover_stale(out: str | Path) -> None:

@@ -284,6 +284,8 @@ INDEX = (
            "term in the reward", "scripts/select_defaults.py --round 4"),
     Result("selection/round1/selection.md", "selection/round1/selection.json", "its first round, before the "
            "lattice fix", "scripts/select_defaults.py --round 1"),
+    Result("sfm/register_curve.md", "sfm/register_curve.json", "COLMAP registration per view count and "
+           "resolution: the policy, the tuned orbit, random views", "scripts/sfm_register_curve.py"),
     Result("sfm/tiled/register_curve.md", "sfm/tiled/register_curve.json", "COLMAP registration per view "
            "count and resolution, on the tiled look: the policy, the tuned orbit, random views",
            "scripts/sfm_register_curve.py --scene medieval_tavern@tiled"),

@@ -35,7 +35,7 @@ from nbv.recon.fused_coverage import as_stored
 from nbv.recon.metrics import evaluate_surfaces, load_geometry
 from nbv.recon.tsdf import reconstruct_dataset
 from nbv.recon.visibility import scene_visibility
-from nbv.sfm.config import SfmOption
+from nbv.sfm.config import LinkSettings, SfmOption
 from render.dataset import read_dataset
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes.spec import MeshOrientation, SceneSpec
@@ -134,10 +134,14 @@ def scene_spec(study: PlannerStudy, scene: str) -> SceneSpec:
 
 
 def plan_config(study: PlannerStudy, scene: str, planner: str, seed: int, views: int | None) -> PlanConfig:
-    """The `nbv plan` run of one building, planner, seed and budget under the study's settings."""
+    """The `nbv plan` run of one building, planner, seed and budget under the study's settings
+    (`--min-matches` reaches the planners that choose among candidates; fixed patterns fly their views)."""
+    settings = study.settings
+    if "links" not in entry(planner).settings:
+        settings = replace(settings, links=LinkSettings())
     return PlanConfig(scene=scene_spec(study, scene), views=views, planner=planner, seed=seed,
                       out=run_folder(study, scene, planner, seed, views), overwrite=True,
-                      settings=study.settings, sfm=study.sfm, sfm_settings=study.sfm_settings)
+                      settings=settings, sfm=study.sfm, sfm_settings=study.sfm_settings)
 
 
 def reference_units(study: PlannerStudy) -> list[Task]:

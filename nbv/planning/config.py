@@ -45,6 +45,9 @@ class PlanSettings:
     links: LinkSettings = LinkSettings()
     """Registrability of the flown set (beyond the paper, off by default): random, greedy and infogain fly
     only candidates sharing >= --min-matches verified matches with a view flown (`nbv.planning.linking`)."""
+    blank_images: bool = False
+    """A policy's captured images replaced by blank ones before it sees them (an evaluation test, beyond the
+    paper: a policy that looks at its images loses coverage; the poses flown and the views scored stay)."""
     reference: Path | None = None
     """Reference mesh (full-scan reconstruction); default: reconstruct the hemisphere scan, cached."""
     full_scan: bool = True

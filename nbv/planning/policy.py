@@ -89,9 +89,11 @@ class PolicyPlanner(Planner):
 
 def policy_planner(settings: PlanSettings, seed: int, checkpoint: str | None) -> PolicyPlanner:
     """The registry's `policy`: the checkpoint's actor (none: the shipped one) on its mode."""
-    return PolicyPlanner(checkpoint or SHIPPED_POLICY, sample=False, seed=seed)
+    return PolicyPlanner(checkpoint or SHIPPED_POLICY, sample=False, seed=seed,
+                         blank_images=settings.blank_images)
 
 
 def sampled_policy_planner(settings: PlanSettings, seed: int, checkpoint: str | None) -> PolicyPlanner:
     """The registry's `policy-sample`: the checkpoint's actor (none: the shipped one) on seeded draws."""
-    return PolicyPlanner(checkpoint or SHIPPED_POLICY, sample=True, seed=seed)
+    return PolicyPlanner(checkpoint or SHIPPED_POLICY, sample=True, seed=seed,
+                         blank_images=settings.blank_images)

@@ -92,9 +92,10 @@ PLANNERS: tuple[PlannerEntry, ...] = (
                  "nbv.planning.infogain:infogain_planner", settings=("candidates", "occupancy", "links")),
     PlannerEntry("policy", "a trained actor (a `nbv train` checkpoint.pt or policy.pt; none: the shipped "
                  "policy) from the start view, acting on its distribution's mode",
-                 "nbv.planning.policy:policy_planner", checkpoint=True),
+                 "nbv.planning.policy:policy_planner", settings=("blank_images",), checkpoint=True),
     PlannerEntry("policy-sample", "the same, acting on seeded draws from the distribution",
-                 "nbv.planning.policy:sampled_policy_planner", checkpoint=True, budget=False),
+                 "nbv.planning.policy:sampled_policy_planner", settings=("blank_images",), checkpoint=True,
+                 budget=False),
     PlannerEntry("oracle", "at least every other budget planner on the reported coverage (TSDF, of the true "
                  "surface): the best, on that measure, of each one's views and of its own greedy pick over "
                  "them, the start view and the views an ideal sensor sees most from (a 756-view lattice)",

@@ -154,13 +154,15 @@ COMMANDS = {
     "tables": (PaperConfig, [], lambda c: [t.kwargs["config"] for t in
                                            plan_units(budget_config(c).study(Path("runs")))],
                {("bov", "ranges"), ("bov", "words"), ("bov", "elevation_bands"), ("reference",),
-                ("full_scan",), ("links", "min_matches"), ("links", "link_neighbours")}),
-    # --ranges and --words are Table 2's grid; the curves score the truth; --min-matches is not a tables flag
+                ("full_scan",), ("links", "min_matches"), ("links", "link_neighbours"), ("blank_images",)}),
+    # --ranges and --words are Table 2's grid; the curves score the truth; --min-matches and the blank-image
+    # test are not tables flags
     "demo": (DemoConfig, [], lambda c: [t.kwargs["config"] for t in
                                         plan_units(online_study(c, Path("demo"), "policy", c.policy, None))],
              {path for path, _, _ in KNOBS if path[0] in ("bov", "candidates", "occupancy", "reference",
-                                                          "full_scan", "links")}),
-    # policy and random read none; the demo's --min-matches is its refinement's (DemoConfig.links)
+                                                          "full_scan", "links", "blank_images")}),
+    # policy and random read none but the blank-image test, which the demo does not run; the demo's
+    # --min-matches is its refinement's (DemoConfig.links)
 }
 """Per study command: its config, the arguments it needs, the plan configs of the runs it makes, and the
 plan knobs that do not apply to it."""

@@ -1,6 +1,7 @@
 """The Bag of Views observation (`EnvConfig.bov_observation`), the flight-cost reward term and blank images:
 off, the state and the networks are the paper's bit-for-bit (the shipped policy acts as it did); the vector
-on a hand-worked Bag of Views; the flight term on a hand-worked leg; blank images change the state."""
+on a hand-worked Bag of Views; the flight term on a hand-worked leg; blank images change the state and reach
+the policy planners from `nbv plan --blank-images`."""
 
 from __future__ import annotations
 
@@ -14,10 +15,12 @@ from torchrl.envs.utils import ExplorationType, set_exploration_type
 
 from nbv.bov.bag import BagOfViews
 from nbv.bov.config import BoVConfig
+from nbv.cli.parse import parse
 from nbv.features.config import FeatureConfig
 from nbv.flight.path import shell_path
+from nbv.planning.config import PlanConfig
 from nbv.planning.policy import PolicyPlanner
-from nbv.planning.registry import SHIPPED_POLICY
+from nbv.planning.registry import SHIPPED_POLICY, make_planner
 from nbv.rl.agent import make_actor, make_critic
 from nbv.rl.bov_observation import BOV_KEY, bov_observation_size, bov_vector
 from nbv.rl.config import EnvConfig, RewardConfig
@@ -126,3 +129,14 @@ def test_blank_images_change_the_state():
     assert int(seen[-1]["pixels"].sum()) > 0 and int(blank[-1]["pixels"].sum()) == 0
     assert float(seen[-1][BOV_KEY][:8].sum()) > 0 and float(blank[-1][BOV_KEY][:8].sum()) == 0
     assert torch.equal(seen[-1]["viewpoints"], blank[-1]["viewpoints"])  # the same poses flown
+
+
+@pytest.mark.parametrize("planner", ["policy", "policy-sample"])
+def test_nbv_plan_blank_images_reaches_the_policy_planners_only(planner):
+    args = ["test_building", "--out", "x", "--planner", planner]
+    config = parse(PlanConfig, [*args, "--blank-images"], "plan")
+    assert config.settings.blank_images
+    made = make_planner(config.planner, config.settings, seed=0)
+    assert isinstance(made, PolicyPlanner) and made.blank_images
+    default = parse(PlanConfig, args, "plan")
+    assert not make_planner(default.planner, default.settings, seed=0).blank_images

@@ -48,7 +48,8 @@ class SceneSet(MeshOrientation):
 
     scene: Annotated[tuple[str, ...], UseAppendAction]
     """A built-in scene name, random:SEED, family:SEED (each building with @tiled for the old tiled look), or
-    a mesh file path; give --scene several times for several."""
+    a mesh file path; give --scene several times for several (`nbv train`: the scenes given replace the
+    preset's, whatever tyro's "appends to" says)."""
 
     def __post_init__(self) -> None:
         if not self.scene:

@@ -5,7 +5,7 @@ words clustered from a bounded memory of the descriptors the range has taken
 in. Dissimilarity of a descriptor and a word is d = 1 - cos / c, where c is the
 *match cosine*: a descriptor counts as new (d > 0) when its cosine to the
 nearest word is below c. c = 0.5 is the paper's Eq. 1 to the letter
-(d = 1 - 2 cos); our default is c = 0.8.
+(d = 1 - 2 cos); our default is c = 0.78 (`DEFAULT_MATCH_COSINE`).
 
 Why the departure from docs/bov.md (d = 1 - 2 cos): SIFT descriptors are
 non-negative, so even unrelated patches have cosines near 0.5 and a descriptor's
@@ -13,11 +13,10 @@ nearest word has cosine 0.7 to 0.8 in a view of another side of the building
 (0.98 in the next view of a dense scan). With c = 0.5 every view after the first
 of its range scores negative: on 288-view scans of our presets refinement kept
 exactly N views for every W, and Table 2's trend (more words keep fewer views)
-cannot appear. With c = 0.8 the same scans keep 26 to 86 (medieval_tavern) and
-35 to 75 (forest_ruin_house) views over N in {5..11}, W in {10, 20, 30}, fewer as
-W grows and nearly independent of N, as in the paper's Table 2 (23 to 146).
-c = 0.85 keeps 149 to 249; c = 0.75 at most 28. Pass `match_cosine=0.5` for the
-literal rule.
+cannot appear. With c = 0.78 the same scans (the detailed look) keep views over
+N in {5..11}, W in {10, 20, 30} closest to the paper's Table 2 (23 to 146), fewer
+as W grows and nearly independent of N; the rule is sharp in c (docs/bov.md §4,
+paper_results/match_cosine). Pass `match_cosine=0.5` for the literal rule.
 
 Rules (docs/bov.md, where the paper is open):
 

@@ -30,6 +30,11 @@ from render.settings import RenderSettings
 from render.viewpoint import TWO_PI
 from scenes.spec import SceneSet
 
+REWARD_MATCH_COSINE = 0.8
+"""The online reward's match cosine c: the value every training preset and selection round
+(paper_results/selection) used, kept when refinement's default moved to 0.78 with the detailed look
+(docs/bov.md §4); the shipped policy records it."""
+
 
 @dataclass(frozen=True)
 class LatticeConfig:
@@ -61,7 +66,7 @@ class EnvConfig:
     """The render camera (the resolution the features see)."""
     render: RenderSettings = RenderSettings()
     """How views are rendered."""
-    bov: BoVConfig = BoVConfig(ranges=8)
+    bov: BoVConfig = BoVConfig(ranges=8, match_cosine=REWARD_MATCH_COSINE)
     """The Bag of Views of the reward (paper Sec. IV)."""
     lattice: LatticeConfig = LatticeConfig()
     """Optional view lattice for fast training."""

@@ -24,7 +24,6 @@ from dataclasses import replace
 
 import tyro
 
-from nbv.bov.config import BoVConfig
 from nbv.fanout.config import ExecutorConfig
 from nbv.features.config import FeatureConfig
 from nbv.rl.config import (
@@ -72,7 +71,7 @@ def default_preset() -> TrainConfig:
     """The toolkit's default: chosen on validation buildings (paper_results/selection)."""
     paper = paper_preset()
     env = replace(paper.env, camera=UAVCamera(160, 120), render=RenderSettings(spp=4),
-                  bov=BoVConfig(ranges=8, elevation_bands=2, sift=FeatureConfig(backend="opencv")),
+                  bov=replace(paper.env.bov, elevation_bands=2, sift=FeatureConfig(backend="opencv")),
                   lattice=LatticeConfig(enabled=True), action_mode="relative", relative_step=0.125,
                   episode_views=13)
     return replace(paper, env=env, reward=RewardConfig(coverage=COVERAGE_REWARD),

@@ -80,11 +80,11 @@ def test_hand_worked_toy_from_docstring():
 
 
 def test_default_match_cosine_on_the_same_toy():
-    # c = 0.8: view 1's cosine 1/sqrt 2 = 0.707 to the word (e1 + e2)/sqrt 2 is below c, so it is new
-    # enough: d = 1 - 0.7071 / 0.8 = 0.1161 > 0, and it is kept (the paper's c = 0.5 drops it).
+    # c = 0.78: view 1's cosine 1/sqrt 2 = 0.707 to the word (e1 + e2)/sqrt 2 is below c, so it is new
+    # enough: d = 1 - 0.7071 / 0.78 = 0.0934 > 0, and it is kept (the paper's c = 0.5 drops it).
     bov = BagOfViews(ranges=2, words=1, dim=4)
     bov.update(E[:2], 0.5)
-    assert bov.score(E[:1], 1.0) == pytest.approx(1 - (1 / math.sqrt(2)) / 0.8, abs=1e-6)
+    assert bov.score(E[:1], 1.0) == pytest.approx(1 - (1 / math.sqrt(2)) / 0.78, abs=1e-6)
     assert bov.score(F.normalize(E[0] + 0.5 * E[1], dim=0)[None], 1.0) < 0  # cos 1.5 / sqrt 2.5 = 0.95
 
 
@@ -262,7 +262,8 @@ def test_a_record_of_the_older_flat_feature_settings_reads_as_the_nested_ones():
 
     old = {"match_cosine": 0.8, "memory_cap": 2048, "kmeans_iters": 10, "features": "opencv",
            "max_features": 300, "ranges": 8, "words": 20, "elevation_bands": 2}  # the shipped policy's layout
-    config = BoVConfig(ranges=8, elevation_bands=2, sift=FeatureConfig(backend="opencv", max_features=300))
+    config = BoVConfig(match_cosine=0.8, ranges=8, elevation_bands=2,
+                       sift=FeatureConfig(backend="opencv", max_features=300))
     assert config_from_record(BoVConfig, old) == config
     assert config_from_record(BoVConfig, config_record(config)) == config
     with pytest.raises(ValueError, match="no field"):

@@ -160,7 +160,8 @@ def test_resuming_with_other_settings_is_refused(tmp_path):
         train_run(tiny(tmp_path / "run", 4, seed=8))
     config = tiny(tmp_path / "run", 4)
     other_bov = replace(config, env=replace(config.env, bov=replace(config.env.bov, match_cosine=0.6)))
-    with pytest.raises(CheckpointError, match="env.bov.match_cosine: checkpoint 0.8, now 0.6"):
+    was = config.env.bov.match_cosine
+    with pytest.raises(CheckpointError, match=f"env.bov.match_cosine: checkpoint {was}, now 0.6"):
         train_run(other_bov)
 
 

@@ -71,7 +71,7 @@ def test_the_repair_takes_the_fewest_views_and_joins_every_kept_view():
 
 
 def test_nbv_refine_with_min_matches_adds_the_views_between_two_kept(arc, tmp_path, capsys):
-    common = ["--ranges", "1", "--words", "100", "--feature-backend", "opencv",
+    common = ["--ranges", "1", "--words", "100", "--feature-backend", "opencv", "--match-cosine", "0.8",
               "--cache-dir", str(tmp_path / "cache")]
     assert main(["refine", str(arc), "--out", str(tmp_path / "paper"), *common]) == 0
     paper = json.loads((tmp_path / "paper" / "refine.json").read_text())

@@ -20,6 +20,13 @@ written after every case, so an interrupted run keeps what it measured:
     nice -n 5 python scripts/sfm_register_curve.py --out paper_results/sfm
     nice -n 5 python scripts/sfm_register_curve.py --out /tmp/c --counts 13 --sizes 160x120 --planners random
 
+With `--min-matches K` the planners that choose among candidates (random, greedy, infogain) fly only
+candidates sharing at least K verified matches with a view flown (`nbv plan --min-matches`); their rows
+are named `PLANNER --min-matches K`.
+
+    nice -n 5 python scripts/sfm_register_curve.py --out /tmp/l --planners random greedy --counts 13 20 \
+        --sizes 320x240 --min-matches 15
+
 Held-out buildings are refused: the curve is a measurement on the buildings the planners were made on.
 """
 
@@ -41,9 +48,9 @@ from common.io import cache_dir, markdown_table, write_json, write_text  # noqa:
 from common.provenance import git_commit  # noqa: E402
 from nbv.planning.config import PlanConfig, PlanSettings  # noqa: E402
 from nbv.planning.plan import choose_views, planning_env_config  # noqa: E402
-from nbv.planning.registry import make_planner  # noqa: E402
+from nbv.planning.registry import entry, make_planner  # noqa: E402
 from nbv.sfm.check import sfm_dataset  # noqa: E402
-from nbv.sfm.config import SfmConfig, SfmSettings  # noqa: E402
+from nbv.sfm.config import LinkSettings, SfmConfig, SfmSettings  # noqa: E402
 from render.camera import UAVCamera  # noqa: E402
 from render.scan_cache import ensure_scan  # noqa: E402
 from render.settings import RenderSettings  # noqa: E402
@@ -68,10 +75,22 @@ def parse_size(text: str) -> tuple[int, int]:
     return int(width), int(height)
 
 
-def plan_views(scene: str, planner: str, count: int, seed: int) -> list:
+def links(planner: str, min_matches: int) -> LinkSettings:
+    """`--min-matches` for a planner that reads it (random, greedy, infogain), off for the others."""
+    return LinkSettings(min_matches=min_matches if "links" in entry(planner).settings else 0)
+
+
+def label(planner: str, min_matches: int) -> str:
+    """A case's planner name: the spec, with ` --min-matches K` where the planner flies linked views."""
+    k = links(planner, min_matches).min_matches
+    return f"{planner} --min-matches {k}" if k else planner
+
+
+def plan_views(scene: str, planner: str, count: int, seed: int, min_matches: int = 0) -> list:
     """The planner's `count` viewpoints on `scene` (seed `seed`), as `nbv plan` chooses them."""
+    settings = PlanSettings(full_scan=False, links=links(planner, min_matches))
     config = PlanConfig(scene=SceneSpec(scene=scene), views=count, planner=planner, out=Path("unused"),
-                        seed=seed, settings=PlanSettings(full_scan=False))
+                        seed=seed, settings=settings)
     made = make_planner(planner, config.settings, seed)
     return choose_views(config, made, planning_env_config(config, made))[0]
 
@@ -93,7 +112,7 @@ def headline(report: dict) -> dict:
 def run_case(args: argparse.Namespace, planner: str, count: int, size: tuple[int, int], views: list) -> dict:
     """Render the views at `size` (cached) and run `nbv sfm` on them; the case's headline."""
     camera = UAVCamera(*size)
-    name = f"{planner.replace(':', '_')}-{count}-{size[0]}x{size[1]}"
+    name = f"{planner.replace(':', '_').replace(' --min-matches ', '_links')}-{count}-{size[0]}x{size[1]}"
     folder = cache_dir() / "sfm_register_curve" / f"{args.scene}-{name}"
     ensure_scan(load_scene(args.scene), camera, views, folder, RenderSettings(spp=SPP), progress=False)
     settings = SfmSettings(matching="spatial" if count > args.spatial_above else "exhaustive")
@@ -123,7 +142,7 @@ def write_outputs(args: argparse.Namespace, cases: list[dict], command: str, com
              fmt(c["relative_rotation_median_deg"], ".1f"), "yes" if c["registers"] else "no",
              "yes" if c["right"] else "no"] for c in cases]
     found = []
-    for planner in args.planners:
+    for planner in (label(p, args.min_matches) for p in args.planners):
         for size in sizes:
             mine = [c["count"] for c in cases if (c["planner"], c["size"]) == (planner, size)]
             if mine:
@@ -178,6 +197,8 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--spatial-above", type=int, default=30, help="spatial matching above this count")
     parser.add_argument("--all-counts", action="store_true", help="do not stop at the first that registers")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--min-matches", type=int, default=0,
+                        help="random, greedy and infogain fly only views linked by K verified matches")
     parser.add_argument("--resume", action="store_true",
                         help="reuse OUT/register_curve.json's cases (measured at the commit each records)")
     parser.add_argument("--report-only", action="store_true",
@@ -201,7 +222,8 @@ def main(argv: list[str]) -> int:
     cases: list[dict] = []
     views: dict[tuple[str, int], list] = {}
     for count in sorted(args.counts):
-        for planner in args.planners:
+        for spec in args.planners:
+            planner = label(spec, args.min_matches)
             for size in args.sizes:
                 if not args.all_counts and smallest(cases, planner, f"{size[0]}x{size[1]}", "right"):
                     continue
@@ -210,7 +232,7 @@ def main(argv: list[str]) -> int:
                     cases.append(done[key])
                     continue
                 if (planner, count) not in views:
-                    views[(planner, count)] = plan_views(args.scene, planner, count, args.seed)
+                    views[(planner, count)] = plan_views(args.scene, spec, count, args.seed, args.min_matches)
                 found = run_case(args, planner, count, size, views[(planner, count)])
                 cases.append({**found, "commit": commit})
                 c = cases[-1]

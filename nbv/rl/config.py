@@ -99,6 +99,10 @@ class EnvConfig:
     `nbv.rl.bov_observation`): each vocabulary's word and descriptor fill, the last view's novelty, the
     views left and the metres flown. It reads only the captured images and the poses flown. Off: the
     paper's state (frames and viewpoints), bit-for-bit."""
+    pose_observation: bool = True
+    """The state's `viewpoints` (the paper's). Off (beyond the paper): they are zeros, so the networks must
+    read where the camera is from the frames (and the Bag of Views vector): a test of whether a policy that
+    cannot fly by its poses alone learns to look (issue 26). The env still flies the actions exactly."""
 
     def __post_init__(self) -> None:
         if not 0 < self.radius_min <= self.radius_max:

@@ -389,7 +389,7 @@ class NBVEnv(EnvBase):
                                                       self.config))} if self.config.bov_observation else {}
         return TensorDict({
             "pixels": torch.from_numpy(self._frames.copy()),
-            "viewpoints": torch.from_numpy(self._locations.astype(np.float32)),
+            "viewpoints": torch.from_numpy(self._locations.astype(np.float32) * self.config.pose_observation),
             **extra,
             "done": torch.tensor([terminated or truncated]),
             "terminated": torch.tensor([terminated]),

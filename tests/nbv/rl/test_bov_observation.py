@@ -1,7 +1,8 @@
-"""The Bag of Views observation (`EnvConfig.bov_observation`), the flight-cost reward term and blank images:
-off, the state and the networks are the paper's bit-for-bit (the shipped policy acts as it did); the vector
-on a hand-worked Bag of Views; the flight term on a hand-worked leg; blank images change the state and reach
-the policy planners from `nbv plan --blank-images`."""
+"""The Bag of Views observation (`EnvConfig.bov_observation`), the flight-cost reward term, blank images and
+the pose observation. The vector off: the state and the networks are the paper's bit-for-bit (the shipped
+policy acts as it did); on: the vector on a hand-worked Bag of Views. The flight term on a hand-worked leg.
+Blank images change the state and reach the policy planners from `nbv plan --blank-images`. The poses off:
+the state holds none, and the env flies the same views."""
 
 from __future__ import annotations
 
@@ -140,3 +141,12 @@ def test_nbv_plan_blank_images_reaches_the_policy_planners_only(planner):
     assert isinstance(made, PolicyPlanner) and made.blank_images
     default = parse(PlanConfig, args, "plan")
     assert not make_planner(default.planner, default.settings, seed=0).blank_images
+
+
+def test_without_the_pose_observation_the_state_holds_no_poses_and_the_flight_is_the_same():
+    seen, rewards, views = fly(NBVEnv(config(), seed=4))
+    blind, blind_rewards, blind_views = fly(NBVEnv(config(pose_observation=False), seed=4))
+    assert all(float(s["viewpoints"].abs().sum()) > 0 for s in seen)
+    assert all(float(s["viewpoints"].abs().sum()) == 0 for s in blind)
+    assert [v.as_array().tolist() for v in blind_views] == [v.as_array().tolist() for v in views]
+    assert blind_rewards == rewards and torch.equal(blind[-1]["pixels"], seen[-1]["pixels"])

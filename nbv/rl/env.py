@@ -3,7 +3,8 @@
 State: the last `history` (tau = 5) grayscale frames, downsampled to
 `obs_size` x `obs_size` (uint8, key `pixels`), and the last `history`
 viewpoints (R, azimuth, elevation), each normalised to [-1, 1] over its allowed
-range (key `viewpoints`). At reset both histories hold copies of the first view.
+range (key `viewpoints`; zeros with `pose_observation` off). At reset both
+histories hold copies of the first view.
 
 Action: three values in [-1, 1]. In the paper's `absolute` mode they are the
 next viewpoint itself, rescaled to the allowed ranges of R, azimuth and

@@ -48,8 +48,7 @@ def measure(scans: dict[str, Path], cosines: list[float], work: Path, seed: int)
     for name, dataset in scans.items():
         for c in tqdm(cosines, desc=name, unit="c"):
             config = SweepConfig(dataset=dataset, out=work / f"{name}-c{c}", seed=seed, threads=1,
-                                 ranges=tuple(sorted(set(TABLE2_RANGES))), words=TABLE2_WORDS[:3],
-                                 rule=BoVRule(match_cosine=c))
+                                 rule=BoVRule(match_cosine=c))  # the paper's grid by default
             grid = {(cell["ranges"], cell["words"]): cell["kept_views"] for cell in sweep(config)["grid"]}
             kept.setdefault(name, {})[str(c)] = [grid[n, w] for n, w in zip(TABLE2_RANGES, TABLE2_WORDS)]
     return kept

@@ -46,9 +46,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from common.io import cache_dir, markdown_table, write_json, write_text  # noqa: E402
 from common.provenance import git_commit  # noqa: E402
+from nbv.experiments.planner_study import planner_settings  # noqa: E402
 from nbv.planning.config import PlanConfig, PlanSettings  # noqa: E402
 from nbv.planning.plan import choose_views, planning_env_config  # noqa: E402
-from nbv.planning.registry import entry, make_planner  # noqa: E402
+from nbv.planning.registry import make_planner  # noqa: E402
 from nbv.sfm.check import sfm_dataset  # noqa: E402
 from nbv.sfm.config import LinkSettings, SfmConfig, SfmSettings  # noqa: E402
 from render.camera import UAVCamera  # noqa: E402
@@ -75,20 +76,21 @@ def parse_size(text: str) -> tuple[int, int]:
     return int(width), int(height)
 
 
-def links(planner: str, min_matches: int) -> LinkSettings:
-    """`--min-matches` for a planner that reads it (random, greedy, infogain), off for the others."""
-    return LinkSettings(min_matches=min_matches if "links" in entry(planner).settings else 0)
+def settings_for(planner: str, min_matches: int) -> PlanSettings:
+    """The plan settings of a case: no full scan, `--min-matches` where the planner reads it."""
+    linked = PlanSettings(full_scan=False, links=LinkSettings(min_matches=min_matches))
+    return planner_settings(linked, planner)
 
 
 def label(planner: str, min_matches: int) -> str:
     """A case's planner name: the spec, with ` --min-matches K` where the planner flies linked views."""
-    k = links(planner, min_matches).min_matches
+    k = settings_for(planner, min_matches).links.min_matches
     return f"{planner} --min-matches {k}" if k else planner
 
 
 def plan_views(scene: str, planner: str, count: int, seed: int, min_matches: int = 0) -> list:
     """The planner's `count` viewpoints on `scene` (seed `seed`), as `nbv plan` chooses them."""
-    settings = PlanSettings(full_scan=False, links=links(planner, min_matches))
+    settings = settings_for(planner, min_matches)
     config = PlanConfig(scene=SceneSpec(scene=scene), views=count, planner=planner, out=Path("unused"),
                         seed=seed, settings=settings)
     made = make_planner(planner, config.settings, seed)

@@ -133,12 +133,16 @@ def scene_spec(study: PlannerStudy, scene: str) -> SceneSpec:
     return SceneSpec(scene=scene, up_axis=study.up_axis)
 
 
+def planner_settings(settings: PlanSettings, planner: str) -> PlanSettings:
+    """`settings` for one planner: `--min-matches` reaches the planners that choose among candidates only
+    (fixed patterns fly their views, and `nbv plan` refuses them the flag)."""
+    return settings if "links" in entry(planner).settings else replace(settings, links=LinkSettings())
+
+
 def plan_config(study: PlannerStudy, scene: str, planner: str, seed: int, views: int | None) -> PlanConfig:
     """The `nbv plan` run of one building, planner, seed and budget under the study's settings
-    (`--min-matches` reaches the planners that choose among candidates; fixed patterns fly their views)."""
-    settings = study.settings
-    if "links" not in entry(planner).settings:
-        settings = replace(settings, links=LinkSettings())
+    (`planner_settings`)."""
+    settings = planner_settings(study.settings, planner)
     return PlanConfig(scene=scene_spec(study, scene), views=views, planner=planner, seed=seed,
                       out=run_folder(study, scene, planner, seed, views), overwrite=True,
                       settings=settings, sfm=study.sfm, sfm_settings=study.sfm_settings)

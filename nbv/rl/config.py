@@ -300,7 +300,15 @@ class RewardConfig:
     """Weight W of a flight-cost term: minus W x the metres of the leg to the new view along the viewing
     shell (`nbv.flight.shell_path`), beyond the paper. 0: no flight cost."""
 
+    imitation: Annotated[float, arg(name="imitation")] = 0.0
+    """Weight W of an imitation term in the actor's loss (beyond the paper): W x the squared distance
+    between the actor's mode and the privileged teacher's action (`nbv.rl.expert`: the candidate step that
+    sees the most true surface not seen yet, less the flight term), labelled in every state the training
+    env visits. 0: SAC alone."""
+
     def __post_init__(self) -> None:
+        if not 0 <= self.imitation < math.inf:
+            raise ValueError(f"imitation must be finite and >= 0, got {self.imitation}")
         if not 0 <= self.coverage < math.inf:
             raise ValueError(f"coverage_reward must be finite and >= 0, got {self.coverage}")
         if not 0 <= self.flight < math.inf:

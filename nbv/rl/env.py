@@ -76,6 +76,7 @@ from nbv.recon.visibility import SurfaceVisibility, scene_visibility
 from nbv.rl.bov_observation import BOV_KEY, bov_observation_size, bov_vector, novelty_of
 from nbv.rl.config import EnvConfig, RewardConfig
 from nbv.rl.episode_return import RETURN_KEY
+from nbv.rl.expert import EXPERT_KEY, expert_action
 from nbv.rl.lattice import ViewLattice, build_lattice
 from render.viewpoint import TWO_PI, Viewpoint, draw_viewpoint, viewpoint_to_c2w
 from scenes.model import Scene
@@ -164,6 +165,8 @@ class NBVEnv(EnvBase):
         tau, side = config.history, config.obs_size
         extra = {BOV_KEY: Unbounded(shape=(bov_observation_size(config),), dtype=torch.float32)
                  } if config.bov_observation else {}
+        if reward_terms.imitation:
+            extra[EXPERT_KEY] = Bounded(-1.0, 1.0, shape=(3,), dtype=torch.float32)
         self.observation_spec = Composite(
             pixels=Bounded(0, 255, shape=(tau, side, side), dtype=torch.uint8),
             viewpoints=Bounded(-1.0, 1.0, shape=(tau, 3), dtype=torch.float32),
@@ -219,7 +222,7 @@ class NBVEnv(EnvBase):
         else:
             self.bov.update(descriptors, self._view.azimuth, self._view.elevation)
         self._metres = 0.0
-        if self.reward_terms.coverage:
+        if self.reward_terms.coverage or self.reward_terms.imitation:
             self._seen = self.surface_seen(self._view).copy()  # ours to grow: the node's cache stays as is
         location = normalise_viewpoint(self._view, self.config)
         self._frames = np.repeat(frame[None], self.config.history, axis=0)
@@ -233,7 +236,7 @@ class NBVEnv(EnvBase):
         view = action_to_viewpoint(tensordict["action"], self._view, self.config)
         frame, descriptors = self.capture(view)
         reward = bov_reward = self.bov.reward(descriptors, view.azimuth, view.elevation)
-        if self.reward_terms.coverage:
+        if self.reward_terms.coverage or self.reward_terms.imitation:
             seen = self.surface_seen(view)
             reward += self.reward_terms.coverage * float((seen & ~self._seen).mean())
             self._seen |= seen
@@ -377,6 +380,14 @@ class NBVEnv(EnvBase):
             self._node_seen[scene, index] = seen
         return self._node_seen[scene, index]
 
+    def expert_action(self) -> np.ndarray:
+        """The privileged teacher's action from the current view (`nbv.rl.expert`): it reads the true
+        surface, so training envs with an imitation term alone call it."""
+        step = lambda action, view: action_to_viewpoint(action, view, self.config)  # noqa: E731
+        views_left = (self.config.episode_views or self.config.max_steps + 1) - self._steps - 1
+        return expert_action(self._view, self._seen, self.surface_seen, step, self.reward_terms.flight,
+                             views_left)
+
     def _lattice(self, spec: SceneSpec) -> ViewLattice:
         """The scene's lattice: read from the cache without a renderer, or rendered now."""
         if spec.scene not in self._lattices:
@@ -388,6 +399,8 @@ class NBVEnv(EnvBase):
     def _observation(self, terminated: bool = False, truncated: bool = False) -> TensorDict:
         extra = {BOV_KEY: torch.from_numpy(bov_vector(self.bov, self._novelty, self._steps + 1, self._metres,
                                                       self.config))} if self.config.bov_observation else {}
+        if self.reward_terms.imitation:
+            extra[EXPERT_KEY] = torch.from_numpy(self.expert_action())
         return TensorDict({
             "pixels": torch.from_numpy(self._frames.copy()),
             "viewpoints": torch.from_numpy(self._locations.astype(np.float32) * self.config.pose_observation),

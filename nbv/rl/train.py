@@ -68,6 +68,7 @@ from nbv.rl.checkpoint import (
 )
 from nbv.rl.config import OptimConfig, TrainConfig, upgrade_record
 from nbv.rl.env import NBVEnv
+from nbv.rl.expert import EXPERT_KEY
 from nbv.rl.run_logs import trim_log, validation_fields
 from nbv.rl.validate import LatticeValidator
 from nbv.viz.figures import plot_training_curves
@@ -92,6 +93,13 @@ at most float rounding: runs recorded before the thread policy (threads 0) resum
 Where the lattices are rendered changes nothing but speed."""
 CSV_FIELDS = ("frames", "updates", "reward_mean", "episode_return", "episodes", "loss_actor", "loss_qvalue",
               "entropy", "alpha", "collect_s", "update_s")
+IMITATION_FIELD = "loss_imitation"
+"""The extra `metrics.csv` column of a run with an imitation term (`RewardConfig.imitation`)."""
+
+
+def log_fields(config: TrainConfig) -> tuple[str, ...]:
+    """The run's `metrics.csv` columns: `CSV_FIELDS`, and the imitation loss where it has one."""
+    return CSV_FIELDS + ((IMITATION_FIELD,) if config.reward.imitation else ())
 
 
 def with_defaults(saved: dict) -> dict:
@@ -121,7 +129,7 @@ def train_run(config: TrainConfig) -> Path:
     actor, critic = make_sac_agent(config.env, config.network)
     learner = make_learner(actor, critic, config)
     frames, updates = learner.restore(resumed) if resumed is not None else (0, 0)
-    trim_log(run / METRICS_CSV, frames, CSV_FIELDS)  # the logs end where the checkpoint does
+    trim_log(run / METRICS_CSV, frames, log_fields(config))  # the logs end where the checkpoint does
     trim_log(run / VALIDATION_CSV, frames, validation_fields(config.validation.validation_scenes))
     if frames >= config.collector.frames:
         return run / CHECKPOINT  # the budget is already spent: nothing to do
@@ -149,7 +157,8 @@ def train_run(config: TrainConfig) -> Path:
                 start = time.perf_counter()
                 losses = {}
                 if frames >= config.collector.init_random_frames:  # learning starts after the warm-up
-                    losses, updates = learner.gradient_steps(updates_per_batch, updates, config.optim)
+                    losses, updates = learner.gradient_steps(updates_per_batch, updates, config.optim,
+                                                             config.reward.imitation)
                 log.log_batch(batch, frames, updates, losses, collect_s, time.perf_counter() - start)
 
                 if frames - last_ckpt >= config.logger.checkpoint_every or frames >= config.collector.frames:
@@ -192,13 +201,15 @@ class Learner:
         self.buffer.load_state_dict(resumed["buffer"])
         return int(resumed["counters"]["frames"]), int(resumed["counters"]["updates"])
 
-    def gradient_steps(self, steps: int, updates: int, optim: OptimConfig) -> tuple[dict[str, float], int]:
-        """`steps` SAC gradient steps on replay samples (`sac_update`, Table 1 settings), the target critics
-        soft-updated every `target_update_interval` updates; the last step's losses and the update count."""
+    def gradient_steps(self, steps: int, updates: int, optim: OptimConfig,
+                       imitation: float = 0.0) -> tuple[dict[str, float], int]:
+        """`steps` SAC gradient steps on replay samples (`sac_update`, Table 1 settings, with the imitation
+        weight), the target critics soft-updated every `target_update_interval` updates; the last step's
+        losses and the update count."""
         losses = {}
         for _ in range(steps):
             losses = sac_update(self.loss, self.optim_actor, self.optim_critic, self.buffer.sample(),
-                                optim.reward_scale)
+                                optim.reward_scale, imitation)
             updates += 1
             if updates % optim.target_update_interval == 0:
                 self.target_updater.step()
@@ -238,7 +249,7 @@ class RunLog:
         self._writer = SummaryWriter(str(run / "tensorboard"), purge_step=frames + 1)
         new_csv = not self.csv_path.is_file() or self.csv_path.stat().st_size == 0
         self._file = open(self.csv_path, "a", newline="")
-        self._csv = csv.DictWriter(self._file, CSV_FIELDS)
+        self._csv = csv.DictWriter(self._file, log_fields(config))
         if new_csv:
             self._csv.writeheader()
         self._bar = tqdm(total=config.collector.frames, initial=frames, unit="frame",
@@ -287,9 +298,18 @@ def checkpoint_run(run: Path, config: TrainConfig, learner: Learner, frames: int
     return best
 
 
+def imitation_loss(loss_module: SACLoss, sample: TensorDictBase) -> torch.Tensor:
+    """Mean squared distance between the actor's mode and the teacher's action (`nbv.rl.expert`) over a
+    replay sample."""
+    with loss_module.actor_network_params.to_module(loss_module.actor_network, preserve_module_state=False):
+        mode = loss_module.actor_network.get_dist(sample.select(*loss_module.actor_network.in_keys))
+    return ((mode.deterministic_sample - sample[EXPERT_KEY]) ** 2).sum(-1).mean()
+
+
 def sac_update(loss_module: SACLoss, optim_actor: torch.optim.Optimizer, optim_critic: torch.optim.Optimizer,
-               sample: TensorDictBase, reward_scale: float = 1.0) -> dict[str, float]:
-    """One SAC gradient step on a replay sample, rewards scaled; a learned alpha steps with the actor."""
+               sample: TensorDictBase, reward_scale: float = 1.0, imitation: float = 0.0) -> dict[str, float]:
+    """One SAC gradient step on a replay sample, rewards scaled; a learned alpha steps with the actor; with
+    `imitation` W > 0 the actor's loss adds W x `imitation_loss`."""
     if reward_scale != 1.0:
         sample.set(("next", "reward"), sample["next", "reward"] * reward_scale)
     losses = loss_module(sample)
@@ -298,11 +318,16 @@ def sac_update(loss_module: SACLoss, optim_actor: torch.optim.Optimizer, optim_c
     total = losses["loss_actor"] + losses["loss_qvalue"]
     if loss_module.log_alpha.requires_grad:
         total = total + losses["loss_alpha"]
+    imitated = {}
+    if imitation:
+        bc = imitation_loss(loss_module, sample)
+        total = total + imitation * bc
+        imitated = {IMITATION_FIELD: bc.item()}
     total.backward()
     optim_critic.step()
     optim_actor.step()
     return {"loss_actor": losses["loss_actor"].item(), "loss_qvalue": losses["loss_qvalue"].item(),
-            "entropy": losses["entropy"].item(), "alpha": losses["alpha"].item()}
+            "entropy": losses["entropy"].item(), "alpha": losses["alpha"].item(), **imitated}
 
 
 def validate_checkpoint(validator: LatticeValidator, run: Path, config: TrainConfig, loss_state: dict,

@@ -1,0 +1,78 @@
+"""A privileged teacher for training: the step the true surface says is best (beyond the paper; rl.md §4).
+
+The env's actions are small steps (`relative` mode): a constant step is a fixed spiral, which needs no
+state, and SAC settles on one whatever the building (paper_results/selection/round6). The teacher reads
+what a trained policy may not: the true surface's samples its episode has seen so far. Each of a grid of
+actions (`EXPERT_LEVELS` per coordinate) is scored by flying it `EXPERT_HORIZON` times over (fewer where
+the budget ends first): the new samples each of those views is the first to see, discounted by
+`EXPERT_DISCOUNT` per step, weighted by `TEACHER_COVERAGE`, less the flight-cost weight times the first
+leg's metres along the viewing shell; ties go to the shortest leg. One step alone is too short-sighted:
+where the next 45 degrees hold nothing new, it hovers (measured on `test_building`: stuck at 86 %).
+Its actions depend on the building by construction; `RewardConfig.imitation` pulls the actor's mode
+towards them (`nbv.rl.train.sac_update`), so the actor must read its frames and Bag of Views to follow.
+
+Example: seen from nowhere yet, the shortest leg that sees the one sample wins (a 45-degree turn, inwards
+and a little up, where the shell's arc is shortest).
+    >>> import numpy as np
+    >>> from nbv.rl.config import EnvConfig
+    >>> from nbv.rl.env import action_to_viewpoint
+    >>> from render.viewpoint import Viewpoint
+    >>> from scenes.spec import SceneSet
+    >>> config = EnvConfig(scenes=SceneSet(scene=("test_building",)), action_mode="relative")
+    >>> sees = lambda view: np.array([0.5 < view.azimuth < 1.0])  # one sample, a 45-degree step away
+    >>> step = lambda action, view: action_to_viewpoint(action, view, config)
+    >>> expert_action(Viewpoint(2.0, 0.0, 0.5), np.zeros(1, bool), sees, step, 0.0, 1).tolist()
+    [-1.0, 0.5, 0.5]
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable
+
+import numpy as np
+
+from nbv.flight.path import shell_path
+from render.viewpoint import Viewpoint
+
+EXPERT_LEVELS = (-1.0, -0.5, 0.0, 0.5, 1.0)
+"""The action values the teacher tries per coordinate (5^3 = 125 candidate steps)."""
+EXPERT_HORIZON = 3
+"""How many times over the teacher flies each candidate action to score it."""
+EXPERT_DISCOUNT = 0.9
+"""The weight of a later view's new samples against the next view's, per step."""
+TIE_BREAK_PER_M = 1e-6
+"""A flight cost too small to outweigh one new sample: among equal gains the shortest leg wins."""
+TEACHER_COVERAGE = 100.0
+"""The teacher's weight of new coverage against its flight term (the default's coverage reward weight)."""
+EXPERT_KEY = "expert_action"
+"""The state's key of the teacher's action (training envs with `RewardConfig.imitation` only)."""
+
+
+def candidate_actions() -> np.ndarray:
+    """The teacher's candidate actions, (125, 3), in a fixed order."""
+    return np.array(list(itertools.product(EXPERT_LEVELS, repeat=3)))
+
+
+def expert_action(view: Viewpoint, seen: np.ndarray, sees: Callable[[Viewpoint], np.ndarray],
+                  step: Callable[[np.ndarray, Viewpoint], Viewpoint], flight_weight: float,
+                  views_left: int) -> np.ndarray:
+    """The candidate action of highest score (module docstring) from `view`, given the samples `seen` so
+    far, what each view `sees`, how an action moves (`step(action, view)`), the flight-cost weight per
+    metre and the views still to take; float32 (3,) in [-1, 1]."""
+    horizon = max(1, min(EXPERT_HORIZON, views_left))
+    best, best_score = None, -np.inf
+    for action in candidate_actions():
+        covered, here, gain = seen.copy(), view, 0.0
+        for k in range(horizon):
+            nxt = step(action, here)
+            if k == 0:
+                leg_m = shell_path(view, [nxt]).total_m
+            new = sees(nxt) & ~covered
+            gain += EXPERT_DISCOUNT ** k * float(np.count_nonzero(new)) / max(len(seen), 1)
+            covered |= new
+            here = nxt
+        score = TEACHER_COVERAGE * gain - (flight_weight + TIE_BREAK_PER_M) * leg_m
+        if score > best_score:
+            best, best_score = action, score
+    return best.astype(np.float32)

@@ -1,0 +1,87 @@
+"""How good is the privileged teacher of `--imitation` (nbv.rl.expert)? Its views against the tuned orbit's.
+
+On each validation building and start view (seed), the teacher flies 13 views in a training env (the
+view lattice, its seen samples at the nodes, the flight-cost weight `--flight-reward`), and its exact
+viewpoints are scored as `scripts/looks_eval.py` scores every planner: the share of the true surface the
+views see, and the metres along the viewing shell. A student can at best follow its teacher, so a
+teacher below the orbit is not worth imitating. Validation buildings only.
+
+    python scripts/teacher_eval.py --flight-reward 2 --out paper_results/selection/round7/teacher --work WORK
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from common.io import atomic_folder, write_json, write_text
+from common.provenance import git_commit
+from nbv.planning.base import Planner
+from nbv.planning.config import PlanSettings
+from nbv.planning.registry import make_planner
+from nbv.rl.config import EnvConfig, RewardConfig
+from nbv.rl.env import NBVEnv
+from nbv.rl.expert import EXPERT_KEY
+from nbv.rl.presets import looks_preset
+from render.viewpoint import Viewpoint
+from scenes.family_splits import held_out
+
+sys.path.insert(0, str(Path(__file__).parent))
+from looks_eval import SCENES, evaluate, report  # noqa: E402
+
+
+class TeacherPlanner(Planner):
+    """The teacher's own flight: a training env on the lattice, stepped by its expert action."""
+
+    name = "teacher"
+
+    def __init__(self, trained: EnvConfig, flight: float) -> None:
+        self.trained, self.flight = trained, flight
+
+    def plan(self, world, views: int | None) -> list[Viewpoint]:
+        config = replace(self.trained, scenes=world.env.scenes, episode_views=views or 13)
+        env = NBVEnv(config, seed=world.seed, reward_terms=RewardConfig(imitation=1.0, flight=self.flight))
+        td = env.reset()
+        if env.viewpoint != world.start:
+            raise RuntimeError(f"the teacher starts at {env.viewpoint}, the plan at {world.start}")
+        chosen = [env.viewpoint]
+        for _ in range((views or 13) - 1):
+            td["action"] = td[EXPERT_KEY]
+            td = env.step(td)["next"]
+            chosen.append(env.viewpoint)
+        return chosen
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--flight-reward", type=float, nargs="+", default=[2.0])
+    parser.add_argument("--scenes", nargs="+", default=list(SCENES))
+    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    parser.add_argument("--views", type=int, default=13)
+    parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--work", type=Path, required=True, help="per-planner results, reused when re-run")
+    args = parser.parse_args()
+    refused = [s for s in args.scenes if held_out(s)]
+    if refused:
+        raise SystemExit(f"held-out buildings are not for choosing: {', '.join(refused)}")
+    trained = looks_preset().env
+    planners = {"orbit": (make_planner("orbit", PlanSettings()), False),
+                "random": (make_planner("random", PlanSettings()), False)}
+    planners |= {f"teacher_w{w:g}": (TeacherPlanner(trained, w), False) for w in args.flight_reward}
+    results = evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work)
+    table = report(results, args.scenes, args.seeds, args.views, "orbit")
+    with atomic_folder(args.out, overwrite=True, outputs=("results.json", "results.md")) as out:
+        write_text(out / "results.md", table)
+        write_json(out / "results.json", {"commit": git_commit(), "scenes": args.scenes, "seeds": args.seeds,
+                                          "views": args.views, "results": results, "command": sys.argv})
+    print(table)
+    print("mean coverage:", {n: round(float(np.mean(list(d["summary"]["coverage"].values()))), 1)
+                             for n, d in results.items()})
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,122 @@
+"""The privileged teacher of `--imitation` (nbv.rl.expert), against hand-worked cases, in the training env,
+and the imitation term of the SAC update."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+import torch
+from tensordict import TensorDict
+
+from nbv.bov.config import BoVConfig
+from nbv.features.config import FeatureConfig
+from nbv.rl.builders import make_loss_module, make_optimizers, make_sac_agent
+from nbv.rl.config import EnvConfig, LoggerConfig, RewardConfig, TrainConfig
+from nbv.rl.env import NBVEnv, action_to_viewpoint
+from nbv.rl.expert import EXPERT_KEY, candidate_actions, expert_action
+from nbv.rl.train import IMITATION_FIELD, imitation_loss, sac_update
+from render.camera import UAVCamera
+from render.settings import RenderSettings
+from render.viewpoint import Viewpoint
+from scenes.spec import SceneSet
+
+CONFIG = EnvConfig(scenes=SceneSet(scene=("test_building",)), action_mode="relative")
+"""Steps of at most a quarter of each range: 90 degrees of azimuth."""
+START = Viewpoint(2.0, 0.0, 0.5)
+
+
+def step(action: np.ndarray, view: Viewpoint) -> Viewpoint:
+    return action_to_viewpoint(action, view, CONFIG)
+
+
+def sample_at(low_deg: float, high_deg: float):
+    """`sees` for one surface sample seen from azimuths strictly between two bounds (degrees)."""
+    return lambda view: np.array([low_deg < np.degrees(view.azimuth) < high_deg])
+
+
+def test_candidates_are_the_grid_of_levels():
+    actions = candidate_actions()
+    assert actions.shape == (125, 3) and len({tuple(a) for a in actions}) == 125
+    assert set(actions.ravel()) == {-1.0, -0.5, 0.0, 0.5, 1.0}
+
+
+def test_the_shortest_step_that_sees_the_sample_wins():
+    # +0.5 turns 45 degrees, +1 turns 90: both see a sample at (30, 100) degrees; the shorter leg wins. The
+    # shell's arc is shortest inwards (R 2 -> 1.75 m) and a little up (cos elevation shrinks the turn's
+    # arc): 1.29 m, against 1.38 m for the level 45-degree turn at 2 m.
+    action = expert_action(START, np.zeros(1, bool), sample_at(30, 100), step, 0.0, views_left=12)
+    assert action.tolist() == [-1.0, 0.5, 0.5]
+
+
+def test_the_teacher_looks_past_the_next_step():
+    # Only azimuths in (150, 200) see the sample: no single step (at most 90 degrees) reaches it, but
+    # +1 twice (180) does, and the other way round (-1 twice: 180 too) ties on gain and leg: the first
+    # in the grid's order (-1) wins, inwards and up (the shortest leg). It does not hover.
+    action = expert_action(START, np.zeros(1, bool), sample_at(150, 200), step, 0.0, views_left=12)
+    assert action.tolist() == [-1.0, -1.0, 1.0]
+    # With one view left it cannot get there: every candidate gains nothing and staying put is shortest.
+    last = expert_action(START, np.zeros(1, bool), sample_at(150, 200), step, 0.0, views_left=1)
+    assert last.tolist() == [0, 0, 0]
+
+
+def test_a_seen_sample_counts_nothing_and_a_dear_flight_keeps_it_home():
+    seen = np.ones(1, bool)
+    assert expert_action(START, seen, sample_at(30, 100), step, 0.0, 12).tolist() == [0.0, 0.0, 0.0]
+    # One sample of one is a gain of 100 (TEACHER_COVERAGE); the shortest leg that sees it is 1.29 m.
+    unseen = np.zeros(1, bool)
+    assert expert_action(START, unseen, sample_at(30, 100), step, 100.0, 12).tolist() == [0, 0, 0]
+    assert expert_action(START, unseen, sample_at(30, 100), step, 50.0, 12).tolist() == [-1, 0.5, 0.5]
+
+
+def tiny_env(**terms) -> NBVEnv:
+    config = EnvConfig(scenes=SceneSet(scene=("test_building",)), camera=UAVCamera(64, 48),
+                       render=RenderSettings(spp=1),
+                       bov=BoVConfig(ranges=4, sift=FeatureConfig(backend="opencv")),
+                       obs_size=16, action_mode="relative", episode_views=4)
+    return NBVEnv(config, reward_terms=RewardConfig(**terms))
+
+
+def test_the_training_env_labels_every_state_with_the_teachers_action():
+    env = tiny_env(imitation=1.0)
+    assert EXPERT_KEY in env.observation_spec.keys()
+    td = env.reset()
+    for _ in range(3):
+        view, seen = env.viewpoint, env._seen.copy()
+        assert env.observation_spec[EXPERT_KEY].is_in(td[EXPERT_KEY])
+        moves = lambda a, v: action_to_viewpoint(a, v, env.config)  # noqa: E731
+        expected = expert_action(view, seen, env.surface_seen, moves, 0.0, 4 - env._steps - 1)
+        assert td[EXPERT_KEY].tolist() == expected.tolist()
+        td = env.step(td.set("action", td[EXPERT_KEY]))["next"]
+    # An env without the term has no teacher: it never reads the true mesh for it.
+    plain = tiny_env()
+    assert EXPERT_KEY not in plain.observation_spec.keys() and EXPERT_KEY not in plain.reset().keys()
+
+
+def test_the_imitation_term_pulls_the_actors_mode_to_the_teacher():
+    env = EnvConfig(scenes=SceneSet(scene=("test_building",)), camera=UAVCamera(64, 48), obs_size=16)
+    config = TrainConfig(env=env, logger=LoggerConfig(out=None))
+    torch.manual_seed(0)
+    actor, critic = make_sac_agent(config.env, config.network)
+    loss, _ = make_loss_module(actor, critic, config.optim)
+    optim_actor, optim_critic = make_optimizers(loss, config.optim)
+    n = 8
+    state = {"pixels": torch.randint(0, 255, (n, 5, 16, 16), dtype=torch.uint8),
+             "viewpoints": torch.zeros(n, 5, 3)}
+    teacher = torch.tensor([0.0, 0.5, -0.5]).expand(n, 3)
+    sample = TensorDict({**state, EXPERT_KEY: teacher, "action": torch.zeros(n, 3), "next": TensorDict({
+        **state, "reward": torch.zeros(n, 1), "done": torch.zeros(n, 1, dtype=torch.bool),
+        "terminated": torch.zeros(n, 1, dtype=torch.bool)}, [n])}, [n])
+    before = imitation_loss(loss, sample.clone()).item()
+    logged = [sac_update(loss, optim_actor, optim_critic, sample.clone(), imitation=10.0)[IMITATION_FIELD]
+              for _ in range(60)]
+    assert logged[0] == pytest.approx(before)
+    assert imitation_loss(loss, sample.clone()).item() < 0.1 * before
+    assert IMITATION_FIELD not in sac_update(loss, optim_actor, optim_critic, sample.clone())
+
+
+def test_a_negative_imitation_weight_is_refused():
+    with pytest.raises(ValueError, match="imitation must be finite and >= 0"):
+        RewardConfig(imitation=-1.0)
+    assert replace(RewardConfig(), imitation=2.0).imitation == 2.0

@@ -6,7 +6,8 @@ viewpoints are scored as `scripts/looks_eval.py` scores every planner: the share
 views see, and the metres along the viewing shell. A student can at best follow its teacher, so a
 teacher below the orbit is not worth imitating. Validation buildings only.
 
-    python scripts/teacher_eval.py --flight-reward 2 --out paper_results/selection/round7/teacher --work WORK
+    python scripts/teacher_eval.py --flight-reward 0.5 --teacher-horizon 0 --teacher-discount 1 \
+        --out paper_results/selection/round7/teacher --work WORK
 """
 
 from __future__ import annotations
@@ -39,12 +40,12 @@ class TeacherPlanner(Planner):
 
     name = "teacher"
 
-    def __init__(self, trained: EnvConfig, flight: float) -> None:
-        self.trained, self.flight = trained, flight
+    def __init__(self, trained: EnvConfig, terms: RewardConfig) -> None:
+        self.trained, self.terms = trained, terms
 
     def plan(self, world, views: int | None) -> list[Viewpoint]:
         config = replace(self.trained, scenes=world.env.scenes, episode_views=views or 13)
-        env = NBVEnv(config, seed=world.seed, reward_terms=RewardConfig(imitation=1.0, flight=self.flight))
+        env = NBVEnv(config, seed=world.seed, reward_terms=self.terms)
         td = env.reset()
         if env.viewpoint != world.start:
             raise RuntimeError(f"the teacher starts at {env.viewpoint}, the plan at {world.start}")
@@ -58,7 +59,9 @@ class TeacherPlanner(Planner):
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--flight-reward", type=float, nargs="+", default=[2.0])
+    parser.add_argument("--flight-reward", type=float, nargs="+", default=[0.5])
+    parser.add_argument("--teacher-horizon", type=int, default=3, help="0: to the end of the budget")
+    parser.add_argument("--teacher-discount", type=float, default=0.9)
     parser.add_argument("--scenes", nargs="+", default=list(SCENES))
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
     parser.add_argument("--views", type=int, default=13)
@@ -71,7 +74,11 @@ def main() -> None:
     trained = looks_preset().env
     planners = {"orbit": (make_planner("orbit", PlanSettings()), False),
                 "random": (make_planner("random", PlanSettings()), False)}
-    planners |= {f"teacher_w{w:g}": (TeacherPlanner(trained, w), False) for w in args.flight_reward}
+    teacher = f"teacher_h{args.teacher_horizon}_d{args.teacher_discount:g}"
+    for w in args.flight_reward:
+        terms = RewardConfig(imitation=1.0, flight=w, teacher_horizon=args.teacher_horizon,
+                             teacher_discount=args.teacher_discount)
+        planners[f"{teacher}_w{w:g}"] = (TeacherPlanner(trained, terms), False)
     results = evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work)
     table = report(results, args.scenes, args.seeds, args.views, "orbit")
     with atomic_folder(args.out, overwrite=True, outputs=("results.json", "results.md")) as out:

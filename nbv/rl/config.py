@@ -306,7 +306,18 @@ class RewardConfig:
     sees the most true surface not seen yet, less the flight term), labelled in every state the training
     env visits. 0: SAC alone."""
 
+    teacher_horizon: Annotated[int, arg(name="teacher-horizon")] = 3
+    """How many times over the teacher flies each candidate action to score it (`nbv.rl.expert`); 0: to the
+    end of the episode's view budget."""
+
+    teacher_discount: Annotated[float, arg(name="teacher-discount")] = 0.9
+    """The weight, per step ahead, of a later view's new samples and leg against the next view's."""
+
     def __post_init__(self) -> None:
+        if self.teacher_horizon < 0:
+            raise ValueError(f"teacher_horizon must be >= 0, got {self.teacher_horizon}")
+        if not 0 < self.teacher_discount <= 1:
+            raise ValueError(f"teacher_discount must lie in (0, 1], got {self.teacher_discount}")
         if not 0 <= self.imitation < math.inf:
             raise ValueError(f"imitation must be finite and >= 0, got {self.imitation}")
         if not 0 <= self.coverage < math.inf:

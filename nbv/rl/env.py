@@ -385,8 +385,9 @@ class NBVEnv(EnvBase):
         surface, so training envs with an imitation term alone call it."""
         step = lambda action, view: action_to_viewpoint(action, view, self.config)  # noqa: E731
         views_left = (self.config.episode_views or self.config.max_steps + 1) - self._steps - 1
-        return expert_action(self._view, self._seen, self.surface_seen, step, self.reward_terms.flight,
-                             views_left)
+        terms = self.reward_terms
+        return expert_action(self._view, self._seen, self.surface_seen, step, terms.flight, views_left,
+                             terms.teacher_horizon, terms.teacher_discount)
 
     def _lattice(self, spec: SceneSpec) -> ViewLattice:
         """The scene's lattice: read from the cache without a renderer, or rendered now."""

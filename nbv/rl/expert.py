@@ -3,11 +3,13 @@
 The env's actions are small steps (`relative` mode): a constant step is a fixed spiral, which needs no
 state, and SAC settles on one whatever the building (paper_results/selection/round6). The teacher reads
 what a trained policy may not: the true surface's samples its episode has seen so far. Each of a grid of
-actions (`EXPERT_LEVELS` per coordinate) is scored by flying it `EXPERT_HORIZON` times over (fewer where
-the budget ends first): the new samples each of those views is the first to see, discounted by
-`EXPERT_DISCOUNT` per step, weighted by `TEACHER_COVERAGE`, less the flight-cost weight times the first
-leg's metres along the viewing shell; ties go to the shortest leg. One step alone is too short-sighted:
-where the next 45 degrees hold nothing new, it hovers (measured on `test_building`: stuck at 86 %).
+actions (`EXPERT_LEVELS` per coordinate) is scored by flying it `horizon` times over (`RewardConfig.
+teacher_horizon`; fewer where the budget ends first, 0: to the end of it): for each of those views, the
+share of samples it is the first to see times `TEACHER_COVERAGE`, less the flight-cost weight times its
+leg's metres along the viewing shell, discounted by `discount` per step ahead; ties go to the shortest
+flight. One step alone is too short-sighted: where the next 45 degrees hold nothing new, it hovers
+(measured on `test_building`: stuck at 86 %). With the horizon at the budget's end and no discount it is
+the best spiral from here, chosen again at every view.
 Its actions depend on the building by construction; `RewardConfig.imitation` pulls the actor's mode
 towards them (`nbv.rl.train.sac_update`), so the actor must read its frames and Bag of Views to follow.
 
@@ -37,10 +39,6 @@ from render.viewpoint import Viewpoint
 
 EXPERT_LEVELS = (-1.0, -0.5, 0.0, 0.5, 1.0)
 """The action values the teacher tries per coordinate (5^3 = 125 candidate steps)."""
-EXPERT_HORIZON = 3
-"""How many times over the teacher flies each candidate action to score it."""
-EXPERT_DISCOUNT = 0.9
-"""The weight of a later view's new samples against the next view's, per step."""
 TIE_BREAK_PER_M = 1e-6
 """A flight cost too small to outweigh one new sample: among equal gains the shortest leg wins."""
 TEACHER_COVERAGE = 100.0
@@ -56,23 +54,23 @@ def candidate_actions() -> np.ndarray:
 
 def expert_action(view: Viewpoint, seen: np.ndarray, sees: Callable[[Viewpoint], np.ndarray],
                   step: Callable[[np.ndarray, Viewpoint], Viewpoint], flight_weight: float,
-                  views_left: int) -> np.ndarray:
+                  views_left: int, horizon: int = 3, discount: float = 0.9) -> np.ndarray:
     """The candidate action of highest score (module docstring) from `view`, given the samples `seen` so
     far, what each view `sees`, how an action moves (`step(action, view)`), the flight-cost weight per
-    metre and the views still to take; float32 (3,) in [-1, 1]."""
-    horizon = max(1, min(EXPERT_HORIZON, views_left))
+    metre, the views still to take, the horizon (0: all of them) and the discount; float32 (3,) in
+    [-1, 1]."""
+    horizon = max(1, min(horizon or views_left, views_left))
     best, best_score = None, -np.inf
     for action in candidate_actions():
-        covered, here, gain = seen.copy(), view, 0.0
+        covered, here, score, flown = seen.copy(), view, 0.0, []
         for k in range(horizon):
-            nxt = step(action, here)
-            if k == 0:
-                leg_m = shell_path(view, [nxt]).total_m
-            new = sees(nxt) & ~covered
-            gain += EXPERT_DISCOUNT ** k * float(np.count_nonzero(new)) / max(len(seen), 1)
+            here = step(action, here)
+            new = sees(here) & ~covered
+            score += discount ** k * TEACHER_COVERAGE * float(np.count_nonzero(new)) / max(len(seen), 1)
             covered |= new
-            here = nxt
-        score = TEACHER_COVERAGE * gain - (flight_weight + TIE_BREAK_PER_M) * leg_m
+            flown.append(here)
+        legs = shell_path(view, flown).legs_m
+        score -= sum(discount ** k * (flight_weight + TIE_BREAK_PER_M) * m for k, m in enumerate(legs))
         if score > best_score:
             best, best_score = action, score
     return best.astype(np.float32)

@@ -46,7 +46,7 @@ def test_the_shortest_step_that_sees_the_sample_wins():
     # +0.5 turns 45 degrees, +1 turns 90: both see a sample at (30, 100) degrees; the shorter leg wins. The
     # shell's arc is shortest inwards (R 2 -> 1.75 m) and a little up (cos elevation shrinks the turn's
     # arc): 1.29 m, against 1.38 m for the level 45-degree turn at 2 m.
-    action = expert_action(START, np.zeros(1, bool), sample_at(30, 100), step, 0.0, views_left=12)
+    action = expert_action(START, np.zeros(1, bool), sample_at(30, 100), step, 0.0, views_left=1)
     assert action.tolist() == [-1.0, 0.5, 0.5]
 
 
@@ -64,10 +64,18 @@ def test_the_teacher_looks_past_the_next_step():
 def test_a_seen_sample_counts_nothing_and_a_dear_flight_keeps_it_home():
     seen = np.ones(1, bool)
     assert expert_action(START, seen, sample_at(30, 100), step, 0.0, 12).tolist() == [0.0, 0.0, 0.0]
-    # One sample of one is a gain of 100 (TEACHER_COVERAGE); the shortest leg that sees it is 1.29 m.
+    # One sample of one is a gain of 100 (TEACHER_COVERAGE); the shortest leg that sees it is 1.29 m. One
+    # view left: that leg alone is paid for.
     unseen = np.zeros(1, bool)
-    assert expert_action(START, unseen, sample_at(30, 100), step, 100.0, 12).tolist() == [0, 0, 0]
-    assert expert_action(START, unseen, sample_at(30, 100), step, 50.0, 12).tolist() == [-1, 0.5, 0.5]
+    assert expert_action(START, unseen, sample_at(30, 100), step, 100.0, 1).tolist() == [0, 0, 0]
+    assert expert_action(START, unseen, sample_at(30, 100), step, 50.0, 1).tolist() == [-1, 0.5, 0.5]
+    # With more views left the teacher pays for the legs after it too (flying the same step on, discounted
+    # by 0.9 and 0.81, each about 1.3 m): at 50 a metre the sample no longer pays for the flight; at 30 it
+    # does over three steps, but not over all eleven undiscounted.
+    assert expert_action(START, unseen, sample_at(30, 100), step, 50.0, 12).tolist() == [0, 0, 0]
+    assert expert_action(START, unseen, sample_at(30, 100), step, 30.0, 12).tolist() == [-1, 0.5, 1]
+    assert expert_action(START, unseen, sample_at(30, 100), step, 30.0, 12, horizon=0, discount=1.0
+                         ).tolist() == [0, 0, 0]
 
 
 def tiny_env(**terms) -> NBVEnv:
@@ -79,14 +87,14 @@ def tiny_env(**terms) -> NBVEnv:
 
 
 def test_the_training_env_labels_every_state_with_the_teachers_action():
-    env = tiny_env(imitation=1.0)
+    env = tiny_env(imitation=1.0, teacher_horizon=2, teacher_discount=0.5)
     assert EXPERT_KEY in env.observation_spec.keys()
     td = env.reset()
     for _ in range(3):
         view, seen = env.viewpoint, env._seen.copy()
         assert env.observation_spec[EXPERT_KEY].is_in(td[EXPERT_KEY])
         moves = lambda a, v: action_to_viewpoint(a, v, env.config)  # noqa: E731
-        expected = expert_action(view, seen, env.surface_seen, moves, 0.0, 4 - env._steps - 1)
+        expected = expert_action(view, seen, env.surface_seen, moves, 0.0, 4 - env._steps - 1, 2, 0.5)
         assert td[EXPERT_KEY].tolist() == expected.tolist()
         td = env.step(td.set("action", td[EXPERT_KEY]))["next"]
     # An env without the term has no teacher: it never reads the true mesh for it.
@@ -116,7 +124,11 @@ def test_the_imitation_term_pulls_the_actors_mode_to_the_teacher():
     assert IMITATION_FIELD not in sac_update(loss, optim_actor, optim_critic, sample.clone())
 
 
-def test_a_negative_imitation_weight_is_refused():
+def test_bad_imitation_settings_are_refused():
     with pytest.raises(ValueError, match="imitation must be finite and >= 0"):
         RewardConfig(imitation=-1.0)
+    with pytest.raises(ValueError, match="teacher_horizon must be >= 0"):
+        RewardConfig(teacher_horizon=-1)
+    with pytest.raises(ValueError, match=r"teacher_discount must lie in \(0, 1\]"):
+        RewardConfig(teacher_discount=0.0)
     assert replace(RewardConfig(), imitation=2.0).imitation == 2.0

@@ -28,6 +28,7 @@ from nbv.rl.config import EnvConfig, RewardConfig
 from nbv.rl.env import NBVEnv
 from nbv.rl.expert import EXPERT_KEY
 from nbv.rl.presets import looks_preset
+from nbv.viz.figures import plot_seed_scores
 from render.viewpoint import Viewpoint
 from scenes.family_splits import held_out
 
@@ -81,8 +82,12 @@ def main() -> None:
         planners[f"{teacher}_w{w:g}"] = (TeacherPlanner(trained, terms), False)
     results = evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work)
     table = report(results, args.scenes, args.seeds, args.views, "orbit")
-    with atomic_folder(args.out, overwrite=True, outputs=("results.json", "results.md")) as out:
+    outputs = ("results.json", "results.md", "coverage.png")
+    with atomic_folder(args.out, overwrite=True, outputs=outputs) as out:
         write_text(out / "results.md", table)
+        plot_seed_scores({n: list(d["summary"]["coverage"].values()) for n, d in results.items()},
+                         out / "coverage.png", "visible coverage % (validation buildings)",
+                         f"{args.views} views: the teacher vs the tuned orbit")
         write_json(out / "results.json", {"commit": git_commit(), "scenes": args.scenes, "seeds": args.seeds,
                                           "views": args.views, "results": results, "command": sys.argv})
     print(table)

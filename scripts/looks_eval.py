@@ -158,20 +158,30 @@ def report(results: dict, scenes: list[str], seeds: list[int], views: int, refer
             "coverage lost with blank images.\n\n" + markdown_table(head, rows))
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--policy", action="append", default=[], metavar="NAME=PATH", required=True)
-    parser.add_argument("--baselines", nargs="*", default=["orbit", "random"])
+def study_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options every validation study of this kind takes: buildings, start views, views, out, work."""
     parser.add_argument("--scenes", nargs="+", default=list(SCENES))
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
     parser.add_argument("--views", type=int, default=13)
     parser.add_argument("--out", type=Path, required=True)
     parser.add_argument("--work", type=Path, required=True, help="per-planner results, reused when re-run")
-    args = parser.parse_args()
-    refused = [s for s in args.scenes if held_out(s)]
+
+
+def refuse_held_out(scenes: list[str]) -> None:
+    """Exit with a message if any of `scenes` is held out: these studies choose, so validation only."""
+    refused = [s for s in scenes if held_out(s)]
     if refused:
         raise SystemExit(f"held-out buildings are not for choosing: {', '.join(refused)}; give validation "
                          "ones")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--policy", action="append", default=[], metavar="NAME=PATH", required=True)
+    parser.add_argument("--baselines", nargs="*", default=["orbit", "random"])
+    study_arguments(parser)
+    args = parser.parse_args()
+    refuse_held_out(args.scenes)
     policies = {name: PolicyPlanner(path) for name, path in (p.split("=", 1) for p in args.policy)}
     trained = next(iter(policies.values())).env_config
     planners = {name: (p, True) for name, p in policies.items()}

@@ -30,10 +30,9 @@ from nbv.rl.expert import EXPERT_KEY
 from nbv.rl.presets import looks_preset
 from nbv.viz.figures import plot_seed_scores
 from render.viewpoint import Viewpoint
-from scenes.family_splits import held_out
 
 sys.path.insert(0, str(Path(__file__).parent))
-from looks_eval import SCENES, evaluate, report  # noqa: E402
+from looks_eval import evaluate, refuse_held_out, report, study_arguments  # noqa: E402
 
 
 class TeacherPlanner(Planner):
@@ -63,15 +62,9 @@ def main() -> None:
     parser.add_argument("--flight-reward", type=float, nargs="+", default=[0.5])
     parser.add_argument("--teacher-horizon", type=int, default=3, help="0: to the end of the budget")
     parser.add_argument("--teacher-discount", type=float, default=0.9)
-    parser.add_argument("--scenes", nargs="+", default=list(SCENES))
-    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
-    parser.add_argument("--views", type=int, default=13)
-    parser.add_argument("--out", type=Path, required=True)
-    parser.add_argument("--work", type=Path, required=True, help="per-planner results, reused when re-run")
+    study_arguments(parser)
     args = parser.parse_args()
-    refused = [s for s in args.scenes if held_out(s)]
-    if refused:
-        raise SystemExit(f"held-out buildings are not for choosing: {', '.join(refused)}")
+    refuse_held_out(args.scenes)
     trained = looks_preset().env
     planners = {"orbit": (make_planner("orbit", PlanSettings()), False),
                 "random": (make_planner("random", PlanSettings()), False)}

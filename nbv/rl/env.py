@@ -28,7 +28,10 @@ With training-only `reward_terms` (`RewardConfig`, given by the training builder
 alone) of coverage weight W > 0 (beyond the paper: it reads the true mesh) the
 reward adds W x the share of the target's surface samples
 (`nbv.recon.visibility`) that the new view is the episode's first to see; on
-a lattice that is the node's view, as the frame is.
+a lattice that is the node's view, as the frame is. With an imitation weight
+> 0 (`RewardConfig.imitation`) every state also holds the privileged teacher's
+action (`expert_action`, `nbv.rl.expert`), which the actor never reads: the
+SAC update pulls the actor's mode towards it.
 
 Termination: one pass around the target, i.e. the net azimuth travelled
 (each step's change wrapped to (-pi, pi]) reaches 2 pi in either direction;

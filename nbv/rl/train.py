@@ -302,8 +302,8 @@ def imitation_loss(loss_module: SACLoss, sample: TensorDictBase) -> torch.Tensor
     """Mean squared distance between the actor's mode and the teacher's action (`nbv.rl.expert`) over a
     replay sample."""
     with loss_module.actor_network_params.to_module(loss_module.actor_network, preserve_module_state=False):
-        mode = loss_module.actor_network.get_dist(sample.select(*loss_module.actor_network.in_keys))
-    return ((mode.deterministic_sample - sample[EXPERT_KEY]) ** 2).sum(-1).mean()
+        dist = loss_module.actor_network.get_dist(sample.select(*loss_module.actor_network.in_keys))
+    return ((dist.deterministic_sample - sample[EXPERT_KEY]) ** 2).sum(-1).mean()
 
 
 def sac_update(loss_module: SACLoss, optim_actor: torch.optim.Optimizer, optim_critic: torch.optim.Optimizer,

@@ -23,7 +23,7 @@ and a little up, where the shell's arc is shortest).
     >>> config = EnvConfig(scenes=SceneSet(scene=("test_building",)), action_mode="relative")
     >>> sees = lambda view: np.array([0.5 < view.azimuth < 1.0])  # one sample, a 45-degree step away
     >>> step = lambda action, view: action_to_viewpoint(action, view, config)
-    >>> expert_action(Viewpoint(2.0, 0.0, 0.5), np.zeros(1, bool), sees, step, 0.0, 1).tolist()
+    >>> expert_action(Viewpoint(2.0, 0.0, 0.5), np.zeros(1, bool), sees, step, 0.0, 1, 3, 0.9).tolist()
     [-1.0, 0.5, 0.5]
 """
 
@@ -47,21 +47,25 @@ EXPERT_KEY = "expert_action"
 """The state's key of the teacher's action (training envs with `RewardConfig.imitation` only)."""
 
 
+CANDIDATES = np.array(list(itertools.product(EXPERT_LEVELS, repeat=3)))
+"""The teacher's candidate actions, (125, 3), in a fixed order (built once, not at every step)."""
+
+
 def candidate_actions() -> np.ndarray:
-    """The teacher's candidate actions, (125, 3), in a fixed order."""
-    return np.array(list(itertools.product(EXPERT_LEVELS, repeat=3)))
+    """The teacher's candidate actions, (125, 3), in a fixed order (a copy of `CANDIDATES`)."""
+    return CANDIDATES.copy()
 
 
 def expert_action(view: Viewpoint, seen: np.ndarray, sees: Callable[[Viewpoint], np.ndarray],
                   step: Callable[[np.ndarray, Viewpoint], Viewpoint], flight_weight: float,
-                  views_left: int, horizon: int = 3, discount: float = 0.9) -> np.ndarray:
+                  views_left: int, horizon: int, discount: float) -> np.ndarray:
     """The candidate action of highest score (module docstring) from `view`, given the samples `seen` so
     far, what each view `sees`, how an action moves (`step(action, view)`), the flight-cost weight per
-    metre, the views still to take, the horizon (0: all of them) and the discount; float32 (3,) in
-    [-1, 1]."""
+    metre, the views still to take, the horizon (0: all of them) and the discount (their defaults are
+    `RewardConfig.teacher_horizon` and `teacher_discount`'s); float32 (3,) in [-1, 1]."""
     horizon = max(1, min(horizon or views_left, views_left))
     best, best_score = None, -np.inf
-    for action in candidate_actions():
+    for action in CANDIDATES:
         covered, here, score, flown = seen.copy(), view, 0.0, []
         for k in range(horizon):
             here = step(action, here)

@@ -25,6 +25,8 @@ from scenes.spec import SceneSet
 CONFIG = EnvConfig(scenes=SceneSet(scene=("test_building",)), action_mode="relative")
 """Steps of at most a quarter of each range: 90 degrees of azimuth."""
 START = Viewpoint(2.0, 0.0, 0.5)
+TEACHER = {"horizon": RewardConfig().teacher_horizon, "discount": RewardConfig().teacher_discount}
+"""The teacher's default look-ahead (3 steps, 0.9 a step)."""
 
 
 def step(action: np.ndarray, view: Viewpoint) -> Viewpoint:
@@ -46,7 +48,7 @@ def test_the_shortest_step_that_sees_the_sample_wins():
     # +0.5 turns 45 degrees, +1 turns 90: both see a sample at (30, 100) degrees; the shorter leg wins. The
     # shell's arc is shortest inwards (R 2 -> 1.75 m) and a little up (cos elevation shrinks the turn's
     # arc): 1.29 m, against 1.38 m for the level 45-degree turn at 2 m.
-    action = expert_action(START, np.zeros(1, bool), sample_at(30, 100), step, 0.0, views_left=1)
+    action = expert_action(START, np.zeros(1, bool), sample_at(30, 100), step, 0.0, views_left=1, **TEACHER)
     assert action.tolist() == [-1.0, 0.5, 0.5]
 
 
@@ -54,27 +56,28 @@ def test_the_teacher_looks_past_the_next_step():
     # Only azimuths in (150, 200) see the sample: no single step (at most 90 degrees) reaches it, but
     # +1 twice (180) does, and the other way round (-1 twice: 180 too) ties on gain and leg: the first
     # in the grid's order (-1) wins, inwards and up (the shortest leg). It does not hover.
-    action = expert_action(START, np.zeros(1, bool), sample_at(150, 200), step, 0.0, views_left=12)
+    far = sample_at(150, 200)
+    action = expert_action(START, np.zeros(1, bool), far, step, 0.0, views_left=12, **TEACHER)
     assert action.tolist() == [-1.0, -1.0, 1.0]
     # With one view left it cannot get there: every candidate gains nothing and staying put is shortest.
-    last = expert_action(START, np.zeros(1, bool), sample_at(150, 200), step, 0.0, views_left=1)
+    last = expert_action(START, np.zeros(1, bool), sample_at(150, 200), step, 0.0, views_left=1, **TEACHER)
     assert last.tolist() == [0, 0, 0]
 
 
 def test_a_seen_sample_counts_nothing_and_a_dear_flight_keeps_it_home():
     seen = np.ones(1, bool)
-    assert expert_action(START, seen, sample_at(30, 100), step, 0.0, 12).tolist() == [0.0, 0.0, 0.0]
+    assert expert_action(START, seen, sample_at(30, 100), step, 0.0, 12, **TEACHER).tolist() == [0, 0, 0]
     # One sample of one is a gain of 100 (TEACHER_COVERAGE); the shortest leg that sees it is 1.29 m. One
     # view left: that leg alone is paid for.
-    unseen = np.zeros(1, bool)
-    assert expert_action(START, unseen, sample_at(30, 100), step, 100.0, 1).tolist() == [0, 0, 0]
-    assert expert_action(START, unseen, sample_at(30, 100), step, 50.0, 1).tolist() == [-1, 0.5, 0.5]
+    unseen, near = np.zeros(1, bool), sample_at(30, 100)
+    assert expert_action(START, unseen, near, step, 100.0, 1, **TEACHER).tolist() == [0, 0, 0]
+    assert expert_action(START, unseen, near, step, 50.0, 1, **TEACHER).tolist() == [-1, 0.5, 0.5]
     # With more views left the teacher pays for the legs after it too (flying the same step on, discounted
     # by 0.9 and 0.81, each about 1.3 m): at 50 a metre the sample no longer pays for the flight; at 30 it
     # does over three steps, but not over all eleven undiscounted.
-    assert expert_action(START, unseen, sample_at(30, 100), step, 50.0, 12).tolist() == [0, 0, 0]
-    assert expert_action(START, unseen, sample_at(30, 100), step, 30.0, 12).tolist() == [-1, 0.5, 1]
-    assert expert_action(START, unseen, sample_at(30, 100), step, 30.0, 12, horizon=0, discount=1.0
+    assert expert_action(START, unseen, near, step, 50.0, 12, **TEACHER).tolist() == [0, 0, 0]
+    assert expert_action(START, unseen, near, step, 30.0, 12, **TEACHER).tolist() == [-1, 0.5, 1]
+    assert expert_action(START, unseen, near, step, 30.0, 12, horizon=0, discount=1.0
                          ).tolist() == [0, 0, 0]
 
 

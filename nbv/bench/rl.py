@@ -116,11 +116,12 @@ def run(quick: bool) -> list[BenchResult]:
     results = []
     updates = sac_updates_per_s(config, 5 if quick else 50)
     results.append(BenchResult("rl", "SAC updates/s, batch 8, 64x64 frames", updates, "updates/s"))
-    for backend, observed in (("kornia", False), ("opencv", False), ("opencv", True)):
+    for backend, observed, looked in (("kornia", False, False), ("opencv", False, False),
+                                      ("opencv", True, False), ("opencv", True, True)):
         sift = replace(config.bov.sift, backend=backend)
-        label = f"{backend} SIFT" + (", BoV observation" if observed else "")
-        stages = planning_ms(replace(config, bov=replace(config.bov, sift=sift), bov_observation=observed),
-                             3 if quick else 12)
+        label = f"{backend} SIFT" + (", BoV observation" if observed else "") + (", look map" * looked)
+        stages = planning_ms(replace(config, bov=replace(config.bov, sift=sift), bov_observation=observed,
+                                     look_map=looked), 3 if quick else 12)
         for stage, ms in stages.items():
             results.append(BenchResult("rl", f"planning {stage} ms/step ({label})", ms, "ms"))
         total = sum(stages.values())

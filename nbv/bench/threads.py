@@ -37,7 +37,9 @@ from nbv.features.source import gray_frame
 from nbv.rl.agent import make_actor
 from nbv.rl.bov_observation import BOV_KEY, bov_observation_size, bov_vector, novelty_of
 from nbv.rl.config import EnvConfig
+from nbv.rl.look_map import LOOK_MAP_SIZE, look_of
 from render.camera import UAVCamera
+from render.viewpoint import Viewpoint
 from scenes import DEFAULT_SCENE
 from scenes.spec import SceneSet
 
@@ -124,6 +126,7 @@ def planning_step_ms(images: np.ndarray, config: EnvConfig, repeats: int) -> dic
     with torch.no_grad(), set_exploration_type(ExplorationType.DETERMINISTIC):
         for p in range(repeats + 1):
             bov = BagOfViews.from_config(config.bov, seed=p)
+            looked = np.zeros(LOOK_MAP_SIZE, np.float32)
             stages = {"features": 0.0, "bov": 0.0, "policy": 0.0}
             for i, rgb in enumerate(images):
                 t0 = time.perf_counter()
@@ -131,7 +134,8 @@ def planning_step_ms(images: np.ndarray, config: EnvConfig, repeats: int) -> dic
                 t1 = time.perf_counter()
                 reward = bov.reward(descriptors, 0.7 * i)
                 if config.bov_observation:
-                    vector = bov_vector(bov, novelty_of(reward, bov), i + 1, 0.5 * i, config)
+                    looked = np.maximum(looked, look_of(Viewpoint(2.0, 0.7 * i, 0.3)))
+                    vector = bov_vector(bov, novelty_of(reward, bov), i + 1, 0.5 * i, config, looked)
                     td[BOV_KEY] = torch.from_numpy(vector)
                 t2 = time.perf_counter()
                 td["pixels"] = torch.cat([td["pixels"][1:], torch.from_numpy(gray_frame(rgb, side))[None]])

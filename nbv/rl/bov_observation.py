@@ -15,7 +15,9 @@ through the Bag of Views, and the poses flown), so it is available at inference 
 - views left: (budget - views so far) / budget, the budget being the episode's views (`episode_views`,
   else the step cap + 1);
 - metres flown: the shell path's length so far (`nbv.flight.shell_path`) over one turn of the largest
-  ring, 2 pi `radius_max`.
+  ring, 2 pi `radius_max`;
+- with `EnvConfig.look_map`, the map of where the episode has looked from (`nbv.rl.look_map`, its
+  `LOOK_MAP_SIZE` values), last.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ import numpy as np
 
 from nbv.bov.bag import BagOfViews
 from nbv.rl.config import EnvConfig
+from nbv.rl.look_map import LOOK_MAP_SIZE
 
 BOV_KEY = "bov"
 """The state's key of the vector (absent when `EnvConfig.bov_observation` is off)."""
@@ -37,7 +40,7 @@ def bov_observation_size(config: EnvConfig) -> int:
     """Length of the vector for `config` (0 when the option is off: the paper's state)."""
     if not config.bov_observation:
         return 0
-    return 2 * config.bov.ranges * config.bov.elevation_bands + SCALARS
+    return 2 * config.bov.ranges * config.bov.elevation_bands + SCALARS + LOOK_MAP_SIZE * config.look_map
 
 
 def view_budget(config: EnvConfig) -> int:
@@ -45,14 +48,18 @@ def view_budget(config: EnvConfig) -> int:
     return config.episode_views or config.max_steps + 1
 
 
-def bov_vector(bov: BagOfViews, novelty: float, views: int, metres: float, config: EnvConfig) -> np.ndarray:
+def bov_vector(bov: BagOfViews, novelty: float, views: int, metres: float, config: EnvConfig,
+               looked: np.ndarray | None = None) -> np.ndarray:
     """The vector (float32, `bov_observation_size(config)`) after `views` views, `metres` flown, the last
-    view's novelty `novelty` (`novelty_of`)."""
+    view's novelty `novelty` (`novelty_of`) and, with `config.look_map`, the look map `looked`."""
+    if config.look_map and looked is None:
+        raise ValueError("config.look_map is on: bov_vector needs the look map")
     words = bov.word_count.double().numpy() / bov.num_words
     memory = bov.memory_count.double().numpy() / bov.memory_cap
     budget = view_budget(config)
     scalars = [novelty, (budget - views) / budget, metres / (2.0 * math.pi * config.radius_max)]
-    return np.concatenate([words, memory, scalars]).astype(np.float32)
+    parts = [words, memory, scalars] + ([looked] if config.look_map else [])
+    return np.concatenate(parts).astype(np.float32)
 
 
 def novelty_of(reward: float, bov: BagOfViews) -> float:

@@ -99,6 +99,10 @@ class EnvConfig:
     `nbv.rl.bov_observation`): each vocabulary's word and descriptor fill, the last view's novelty, the
     views left and the metres flown. It reads only the captured images and the poses flown. Off: the
     paper's state (frames and viewpoints), bit-for-bit."""
+    look_map: bool = False
+    """Beyond the paper, with `bov_observation`: the `bov` vector ends in a map of the directions the
+    episode has looked from, from the poses flown alone (`nbv.rl.look_map`): a memory blank images do not
+    empty."""
     pose_observation: bool = True
     """The state's `viewpoints` (the paper's). Off (beyond the paper): they are zeros, so the networks must
     read where the camera is from the frames (and the Bag of Views vector): a test of whether a policy that
@@ -112,6 +116,8 @@ class EnvConfig:
         if not -90 < self.elevation_min_deg <= self.elevation_max_deg < 90:
             raise ValueError("need -90 < elevation_min_deg <= elevation_max_deg < 90, got "
                              f"{self.elevation_min_deg}, {self.elevation_max_deg}")
+        if self.look_map and not self.bov_observation:
+            raise ValueError("look_map extends the Bag of Views vector: it needs bov_observation")
         for name in ("obs_size", "history", "max_steps"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")

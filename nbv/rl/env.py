@@ -81,6 +81,7 @@ from nbv.rl.config import EnvConfig, RewardConfig
 from nbv.rl.episode_return import RETURN_KEY
 from nbv.rl.expert import EXPERT_KEY, expert_action
 from nbv.rl.lattice import ViewLattice, build_lattice
+from nbv.rl.look_map import look_of
 from render.viewpoint import TWO_PI, Viewpoint, draw_viewpoint, viewpoint_to_c2w
 from scenes.model import Scene
 from scenes.spec import SceneSpec
@@ -196,6 +197,7 @@ class NBVEnv(EnvBase):
         self._view: Viewpoint | None = None
         self._return = torch.zeros(1)  # the episode's return so far (float32, summed as `RewardSum` does)
         self._novelty, self._metres = 0.0, 0.0  # the last view's novelty, the metres flown (bov_observation)
+        self._looked: np.ndarray | None = None  # where the episode has looked from (look_map)
         self._set_seed(seed)
 
     # -- TorchRL hooks -------------------------------------------------------------------------
@@ -225,6 +227,7 @@ class NBVEnv(EnvBase):
         else:
             self.bov.update(descriptors, self._view.azimuth, self._view.elevation)
         self._metres = 0.0
+        self._looked = look_of(self._view)
         if self.reward_terms.coverage or self.reward_terms.imitation:
             self._seen = self.surface_seen(self._view).copy()  # ours to grow: the node's cache stays as is
         location = normalise_viewpoint(self._view, self.config)
@@ -248,6 +251,7 @@ class NBVEnv(EnvBase):
             self._metres += leg_m
             self._novelty = novelty_of(bov_reward, self.bov)
             reward -= self.reward_terms.flight * leg_m
+        self._looked = np.maximum(self._looked, look_of(view))
         self._progress += wrap_angle(view.azimuth - self._view.azimuth)
         self._view = view
         self._steps += 1
@@ -324,6 +328,7 @@ class NBVEnv(EnvBase):
             "episode_return": self._return.clone(),
             **({"seen": torch.from_numpy(self._seen.copy())} if self._seen is not None else {}),
             **({"novelty": self._novelty, "metres": self._metres} if self.config.bov_observation else {}),
+            **({"looked": torch.from_numpy(self._looked.copy())} if self.config.look_map else {}),
         }
 
     def restore(self, state: dict[str, Any]) -> None:
@@ -340,6 +345,7 @@ class NBVEnv(EnvBase):
         self.bov.load_state_dict(state["bov"])
         self._seen = state["seen"].numpy().copy() if "seen" in state else None
         self._novelty, self._metres = float(state.get("novelty", 0.0)), float(state.get("metres", 0.0))
+        self._looked = state["looked"].numpy().copy() if "looked" in state else look_of(self._view)
         self._resume_pending = True
 
     # -- rendering -----------------------------------------------------------------------------
@@ -402,7 +408,8 @@ class NBVEnv(EnvBase):
 
     def _observation(self, terminated: bool = False, truncated: bool = False) -> TensorDict:
         extra = {BOV_KEY: torch.from_numpy(bov_vector(self.bov, self._novelty, self._steps + 1, self._metres,
-                                                      self.config))} if self.config.bov_observation else {}
+                                                      self.config, self._looked))
+                 } if self.config.bov_observation else {}
         if self.reward_terms.imitation:
             extra[EXPERT_KEY] = torch.from_numpy(self.expert_action())
         return TensorDict({

@@ -134,7 +134,8 @@ def planning_step_ms(images: np.ndarray, config: EnvConfig, repeats: int) -> dic
                 t1 = time.perf_counter()
                 reward = bov.reward(descriptors, 0.7 * i)
                 if config.bov_observation:
-                    looked = np.maximum(looked, look_of(Viewpoint(2.0, 0.7 * i, 0.3)))
+                    if config.look_map:
+                        looked = np.maximum(looked, look_of(Viewpoint(2.0, 0.7 * i, 0.3)))
                     vector = bov_vector(bov, novelty_of(reward, bov), i + 1, 0.5 * i, config, looked)
                     td[BOV_KEY] = torch.from_numpy(vector)
                 t2 = time.perf_counter()

@@ -227,7 +227,7 @@ class NBVEnv(EnvBase):
         else:
             self.bov.update(descriptors, self._view.azimuth, self._view.elevation)
         self._metres = 0.0
-        self._looked = look_of(self._view)
+        self._looked = look_of(self._view) if self.config.look_map else None
         if self.reward_terms.coverage or self.reward_terms.imitation:
             self._seen = self.surface_seen(self._view).copy()  # ours to grow: the node's cache stays as is
         location = normalise_viewpoint(self._view, self.config)
@@ -251,7 +251,8 @@ class NBVEnv(EnvBase):
             self._metres += leg_m
             self._novelty = novelty_of(bov_reward, self.bov)
             reward -= self.reward_terms.flight * leg_m
-        self._looked = np.maximum(self._looked, look_of(view))
+        if self.config.look_map:
+            self._looked = np.maximum(self._looked, look_of(view))
         self._progress += wrap_angle(view.azimuth - self._view.azimuth)
         self._view = view
         self._steps += 1
@@ -345,7 +346,7 @@ class NBVEnv(EnvBase):
         self.bov.load_state_dict(state["bov"])
         self._seen = state["seen"].numpy().copy() if "seen" in state else None
         self._novelty, self._metres = float(state.get("novelty", 0.0)), float(state.get("metres", 0.0))
-        self._looked = state["looked"].numpy().copy() if "looked" in state else look_of(self._view)
+        self._looked = state["looked"].numpy().copy() if "looked" in state else None
         self._resume_pending = True
 
     # -- rendering -----------------------------------------------------------------------------

@@ -19,6 +19,8 @@ SAC's soft Q-function is a scalar per state-action pair, so ours ends in 1.
 With `extra` > 0 (`EnvConfig.bov_observation`, beyond the paper) both also read the state's `bov`
 vector (..., extra), concatenated to the flattened convolution output before its first fully connected
 layer. With `extra` = 0 the networks, their parameters and their initial draws are the paper's.
+With `NetworkConfig.actor_frames` off (beyond the paper) the actor has no convolutions: its observation
+sub-network is the fully connected layer over the `bov` vector alone (it still takes `pixels`, unread).
 """
 
 from __future__ import annotations
@@ -58,13 +60,16 @@ class ActorNet(nn.Module):
                  extra: int = 0) -> None:
         super().__init__()
         c, h = config.channels, config.hidden
+        if not config.actor_frames and extra == 0:
+            raise ValueError("an actor without frames needs the Bag of Views vector (extra > 0)")
         self.observation = nn.Sequential(
             nn.Conv2d(history, c, 5, stride=2, padding=2), nn.ReLU(),
             nn.Conv2d(c, c, 3, stride=2, padding=1), nn.ReLU(),
             nn.Conv2d(c, c, 3, stride=2, padding=1), nn.ReLU(),
             nn.Flatten(),
-        )
-        conv_out = _conv_out_features(self.observation, (history, obs_size, obs_size))
+        ) if config.actor_frames else None
+        conv_out = 0 if self.observation is None else _conv_out_features(
+            self.observation, (history, obs_size, obs_size))
         self.observation_fc = nn.Sequential(nn.Linear(conv_out + extra, h), nn.ReLU())
         self.location = nn.Sequential(
             nn.Linear(3 * history, config.location_hidden), nn.ReLU(),
@@ -73,10 +78,12 @@ class ActorNet(nn.Module):
 
     def forward(self, pixels: torch.Tensor, viewpoints: torch.Tensor,
                 bov: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
-        frames, batch = _flatten_batch(pixels.float() / 255.0, 3)
-        locations, _ = _flatten_batch(viewpoints, 2)
-        features = torch.cat([self.observation_fc(_with_extra(self.observation(frames), bov)),
-                              self.location(locations.flatten(1))], dim=-1)
+        locations, batch = _flatten_batch(viewpoints, 2)
+        if self.observation is None:
+            observed = _flatten_batch(bov, 1)[0]
+        else:
+            observed = _with_extra(self.observation(_flatten_batch(pixels.float() / 255.0, 3)[0]), bov)
+        features = torch.cat([self.observation_fc(observed), self.location(locations.flatten(1))], dim=-1)
         loc, scale = self.head(features)
         return loc.reshape(*batch, 3), scale.reshape(*batch, 3)
 

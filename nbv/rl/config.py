@@ -157,6 +157,10 @@ class NetworkConfig:
     """Width of the fully connected layers (the paper's 128)."""
     location_hidden: int = 64
     """Width of the first fully connected layer of the location sub-networks (the paper's 64)."""
+    actor_frames: bool = True
+    """The actor reads the frames (the paper's). Off (beyond the paper; needs --bov-observation) it reads
+    the Bag of Views vector and the viewpoints alone, so what it captures reaches it only through the Bag
+    of Views; the critic, used in training only, keeps the frames."""
 
     def __post_init__(self) -> None:
         for name in ("channels", "hidden", "location_hidden"):
@@ -388,6 +392,9 @@ class TrainConfig:
     train (--members): this process, local workers or Ray."""
 
     def __post_init__(self) -> None:
+        if not self.network.actor_frames and not self.env.bov_observation:
+            raise ValueError("an actor without frames (--no-actor-frames) reads the Bag of Views vector: "
+                             "it needs --bov-observation")
         if self.members.count > 1 and not self.validation.enabled:
             raise ValueError(f"members ({self.members.count}) are compared on validation buildings: give "
                              "--validation-scenes")

@@ -41,3 +41,9 @@ def test_unknown_preset_is_one_line(tmp_path, capsys):
     assert "unknown preset 'fast'; presets: default, paper" in capsys.readouterr().err
     with pytest.raises(ValueError, match="unknown preset"):
         split_preset(["--preset", "best"])
+
+
+def test_an_actor_without_frames_is_refused_without_the_bov_vector(tmp_path, capsys):
+    assert not parsed(["--preset", "looks", "--no-actor-frames", "--out", "run"]).network.actor_frames
+    assert main(["train", "--no-actor-frames", "--out", str(tmp_path)]) == 2
+    assert "needs --bov-observation" in capsys.readouterr().err

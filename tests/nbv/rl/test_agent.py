@@ -57,3 +57,18 @@ def test_sac_loss_gives_finite_gradients_to_actor_and_twin_critics():
     grads = [p.grad for p in loss.qvalue_network_params.values(True, True) if p.requires_grad]
     assert grads and all(g is not None and torch.isfinite(g).all() for g in grads)
     assert loss.qvalue_network_params["module", "observation", "0", "weight"].shape[0] == 2  # twin critics
+
+
+def test_actor_without_frames_reads_the_bov_vector_not_the_pixels():
+    torch.manual_seed(0)
+    actor = make_actor(5, 32, NetworkConfig(actor_frames=False), extra=7)
+    assert not any(isinstance(m, nn.Conv2d) for m in actor.modules())
+    td = state((3,)).set("bov", torch.rand(3, 7))
+    loc = actor(td.clone())["loc"]
+    assert torch.equal(loc, actor(td.clone().set("pixels", 255 - td["pixels"]))["loc"])
+    assert not torch.allclose(loc, actor(td.clone().set("bov", torch.zeros(3, 7)))["loc"])
+
+
+def test_actor_without_frames_or_bov_vector_is_refused():
+    with pytest.raises(ValueError, match="needs the Bag of Views vector"):
+        make_actor(5, 32, NetworkConfig(actor_frames=False))

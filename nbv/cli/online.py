@@ -1,4 +1,4 @@
-"""`nbv online [--policies P ...] --out DIR`: the shipped policy against the baselines, held-out buildings."""
+"""`nbv online [--policies P ...] --out DIR`: both shipped policies vs the baselines, held-out buildings."""
 
 from __future__ import annotations
 

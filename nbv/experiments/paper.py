@@ -3,8 +3,9 @@
 Parts, each written onto `--out` as it finishes (an interrupted run keeps the parts done):
 - `table2`: Table 2 and the Fig. 6 heat maps over seeds (`nbv.experiments.table2`);
 - `sec7`: the Sec. VII summary computed from that grid (`sec7.md`, `sec7.json`);
-- `episodes`: Fig. 1 and Fig. 7, the shipped policy's one-pass episodes on its training building and the
-  two held-out presets against the full scan, 5 seeds (`fig1_fig7.{md,json,png}`);
+- `episodes`: Fig. 1 and Fig. 7, the shipped policies' one-pass episodes (the default's and the paper
+  preset's) on the default's training building and the two held-out presets against the full scan, 5 seeds
+  (`fig1_fig7.{md,json,png}`);
 - `budget`: coverage against view budget for every planner on the held-out buildings (`budget/`).
 Then `README.md` maps every file in `--out` to the command, seeds, settings and commit that wrote it.
 """
@@ -31,7 +32,7 @@ from nbv.experiments.paper_numbers import FIG1_NBV, FIG7_GENERALISATION, SEC7_SU
 from nbv.experiments.planner_study import scene_folder
 from nbv.experiments.table2 import TablesConfig, run_tables
 from nbv.planning.config import PlanSettings
-from nbv.planning.registry import budget_planners
+from nbv.planning.registry import budget_planners, planner_label
 from nbv.recon.config import MetricsConfig, OccupancyConfig
 from nbv.sfm.config import SfmOption
 from nbv.viz.paper import plot_episodes
@@ -57,8 +58,9 @@ class PaperConfig(TablesConfig, SfmOption):
     part: Annotated[tuple[Part, ...], UseAppendAction] = ()
     """Run only these parts (repeat --part; default: all): table2, sec7 (needs table2's files), episodes,
     budget."""
-    policy: str = "policy"
-    """The policy of Fig. 1 and Fig. 7 and of the budget curves (policy: the shipped one)."""
+    policies: tuple[str, ...] = ("policy", "policy-paper")
+    """The policies of Fig. 1 and Fig. 7, rows of their own (policy: the shipped default; policy-paper: the
+    paper preset's, so the paper's method stands beside ours); the first is the budget curves' `policy`."""
     fig1_scene: str = "medieval_tavern"
     """Fig. 1's building: one the policy was trained on."""
     held_out: tuple[str, ...] = ("alpine_chalet", "imperial_temple")
@@ -76,6 +78,11 @@ class PaperConfig(TablesConfig, SfmOption):
     """The coverage curves' infogain occupancy grid (`nbv plan`'s)."""
     quick: bool = False
     """A small run on the test building (one seed, 96x72): the defaults of `QUICK`."""
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not self.policies:
+            raise ValueError("nbv tables needs at least one policy (--policies), e.g. policy policy-paper")
 
     @property
     def parts(self) -> tuple[Part, ...]:
@@ -143,7 +150,7 @@ def write_sec7(config: PaperConfig) -> dict[str, Any]:
 def run_episodes(config: PaperConfig) -> list[dict[str, Any]]:
     """Fig. 1 and Fig. 7: the policy's one-pass episodes on `fig1_scene` and the held-out presets, against
     the full scan; writes fig1_fig7.{md,json,png}. Returns one row per building."""
-    keyed = ("up_axis", "camera", "render", "recon", "metrics", "policy")  # what the episodes depend on
+    keyed = ("up_axis", "camera", "render", "recon", "metrics", "policies")  # what the episodes depend on
     runs = run_cache("episodes", config, unkeyed=tuple(f.name for f in fields(config) if f.name not in keyed))
     scenes = [(config.fig1_scene, "Fig. 1 (trained on)"),
               *((s, "Fig. 7 (held out)") for s in config.held_out if s != config.fig1_scene)]
@@ -152,13 +159,15 @@ def run_episodes(config: PaperConfig) -> list[dict[str, Any]]:
         folder = runs / scene_folder(scene)
         settings = PlanSettings(camera=config.camera, render=config.render, metrics=config.metrics,
                                 recon=config.recon)
-        compare_planners(CompareConfig(scene=SceneSpec(scene=scene), planners=(config.policy,),
+        compare_planners(CompareConfig(scene=SceneSpec(scene=scene), planners=config.policies,
                                        seeds=config.episode_seeds, settings=settings, out=folder,
                                        executor=config.executor))
         episodes = json.loads((folder / "comparison.json").read_text())["runs"]
         paper = FIG1_NBV if role.startswith("Fig. 1") else FIG7_GENERALISATION.get(scene, {})
-        rows.append({"scene": scene, "role": role, "seeds": list(config.episode_seeds),
-                     **_episode_stats(episodes), "paper": paper})
+        for policy in map(planner_label, config.policies):
+            mine = [r for r in episodes if r["planner"] == policy]
+            rows.append({"scene": scene, "role": role, "policy": policy, "seeds": list(config.episode_seeds),
+                         **_episode_stats(mine), "paper": paper})
     with atomic_folder(config.out, overwrite=True, outputs=EPISODE_OUTPUTS) as out:
         write_text(out / "fig1_fig7.md", episodes_markdown(rows, config))
         plot_episodes(rows, out / "fig1_fig7.png")
@@ -190,17 +199,20 @@ def episodes_markdown(rows: list[dict[str, Any]], config: PaperConfig) -> str:
         return "-" if value is None else f"{scale * value:.2f}"
 
     body = []
-    for r in rows:
-        body.append([f"{r['scene']}: {r['role']}, ours", pm(r, "views", ".1f"),
+    for i, r in enumerate(rows):
+        body.append([f"{r['scene']}: {r['role']}, ours ({r['policy']})", pm(r, "views", ".1f"),
                      pm(r, "ref_coverage", ".1f"), pm(r, "ref_hausdorff_cm", ".2f"),
                      pm(r, "ref_chamfer_cm", ".2f"), pm(r, "gt_coverage", ".1f")])
+        if i + 1 < len(rows) and rows[i + 1]["scene"] == r["scene"]:
+            continue  # the paper's row once, after the building's last policy
         p = r["paper"]
         body.append([f"{r['scene']}: paper {r['role'].split(' (')[0]}", p.get("views", "-"),
                      paper(p.get("coverage"), 100.0), paper(p.get("hausdorff_cm")),
                      paper(p.get("chamfer_cm")), "-"])
     return "\n".join([
-        f"# Fig. 1 and Fig. 7: the policy's one pass around the target (commit {git_commit()})", "",
-        f"`{config.policy}` acting on its mode until its episode ends (one pass, its own view count), seeds "
+        f"# Fig. 1 and Fig. 7: the policies' one pass around the target (commit {git_commit()})", "",
+        f"{', '.join(f'`{p}`' for p in config.policies)} (the paper preset's policy is `policy-paper`), each "
+        "acting on its mode until its episode ends (one pass, its own view count), seeds "
         f"{', '.join(map(str, config.episode_seeds))}; 'ref' is the reconstruction of the full hemisphere "
         "scan, as in the paper; 'gt' the ground-truth mesh. Paper rows are the paper's own numbers "
         "(Hatami Gazani et al. 2023, Fig. 1 and Fig. 7; '-' where it gives none).", "",
@@ -220,7 +232,7 @@ def budget_settings(config: PaperConfig) -> PlanSettings:
 def budget_config(config: PaperConfig) -> BudgetConfig:
     """The budget part's settings: the held-out buildings, the tables' seeds and plan settings."""
     return BudgetConfig(out=Path(config.out) / "budget", scenes=config.held_out,
-                        planners=tuple(config.policy if p == "policy" else p for p in config.planners),
+                        planners=tuple(config.policies[0] if p == "policy" else p for p in config.planners),
                         seeds=config.seeds, budgets=config.budgets, settings=budget_settings(config),
                         executor=config.executor, sfm=config.sfm, sfm_settings=config.sfm_settings)
 

@@ -3,7 +3,8 @@
 `policy:CHECKPOINT` acts on its action distribution's mode (deterministic);
 `policy-sample:CHECKPOINT` on seeded draws from it (the max-entropy policy SAC
 trained, whose action dimensions the reward does not constrain stay spread).
-Without a checkpoint, the shipped policy (`registry.SHIPPED_POLICY`).
+Without a checkpoint, the shipped policy (`registry.SHIPPED_POLICY`); `policy-paper` flies the paper
+preset's shipped actor (`registry.SHIPPED_PAPER_POLICY`) on its mode.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from typing import TYPE_CHECKING
 
 from common.provenance import config_from_record
 from nbv.planning.base import Planner
-from nbv.planning.registry import SHIPPED_POLICY
+from nbv.planning.registry import SHIPPED_PAPER_POLICY, SHIPPED_POLICY
 from nbv.rl.agent import make_actor
 from nbv.rl.bov_observation import bov_observation_size
 from nbv.rl.checkpoint import CheckpointError, load_policy
@@ -91,6 +92,11 @@ def policy_planner(settings: PlanSettings, seed: int, checkpoint: str | None) ->
     """The registry's `policy`: the checkpoint's actor (none: the shipped one) on its mode."""
     return PolicyPlanner(checkpoint or SHIPPED_POLICY, sample=False, seed=seed,
                          blank_images=settings.blank_images)
+
+
+def paper_policy_planner(settings: PlanSettings, seed: int, checkpoint: str | None) -> PolicyPlanner:
+    """The registry's `policy-paper`: the paper preset's shipped actor on its mode (takes no checkpoint)."""
+    return PolicyPlanner(SHIPPED_PAPER_POLICY, sample=False, seed=seed, blank_images=settings.blank_images)
 
 
 def sampled_policy_planner(settings: PlanSettings, seed: int, checkpoint: str | None) -> PolicyPlanner:

@@ -24,6 +24,9 @@ if TYPE_CHECKING:
 SHIPPED_POLICY = Path(__file__).with_name("shipped") / "policy.pt"
 """The policy of the default `nbv train` command, shipped with the toolkit (its config, metrics log and
 learning curves beside it): what `policy` and `policy-sample` without a checkpoint use."""
+SHIPPED_PAPER_POLICY = SHIPPED_POLICY.parent / "paper" / "policy.pt"
+"""The policy of `nbv train --preset paper` (the paper's Table 1 method, README and config beside it): what
+`policy-paper` flies, so every study can show the paper's method beside the default (issue 26)."""
 
 
 @dataclass(frozen=True)
@@ -96,6 +99,10 @@ PLANNERS: tuple[PlannerEntry, ...] = (
     PlannerEntry("policy-sample", "the same, acting on seeded draws from the distribution",
                  "nbv.planning.policy:sampled_policy_planner", settings=("blank_images",), checkpoint=True,
                  budget=False),
+    PlannerEntry("policy-paper", "the paper's method: the actor `nbv train --preset paper` trained "
+                 "(absolute actions, the Bag of Views reward alone; nbv/planning/shipped/paper/), from the "
+                 "start view, acting on its distribution's mode",
+                 "nbv.planning.policy:paper_policy_planner", settings=("blank_images",)),
     PlannerEntry("oracle", "at least every other budget planner on the reported coverage (TSDF, of the true "
                  "surface): the best, on that measure, of each one's views and of its own greedy pick over "
                  "them, the start view and the views an ideal sensor sees most from (a 756-view lattice)",

@@ -59,21 +59,28 @@ def plot_coverage_metres(coverage: Sequence[dict[str, Any]], metres: Sequence[di
 
 
 def plot_episodes(rows: Sequence[dict[str, Any]], out: str | Path) -> Path:
-    """Bars of our one-pass episodes per building (mean ± std over seeds) for Hausdorff, Chamfer and
-    coverage against the full scan, the paper's value as a red marker where it gives one."""
+    """Bars of our one-pass episodes per building (mean ± std over seeds), one colour per policy, for
+    Hausdorff, Chamfer and coverage against the full scan, the paper's value as a red marker where it gives
+    one."""
     panels = (("ref_hausdorff_cm", "hausdorff_cm", 1.0, "Hausdorff cm (vs full scan)"),
               ("ref_chamfer_cm", "chamfer_cm", 1.0, "Chamfer cm (vs full scan)"),
               ("ref_coverage", "coverage", 100.0, "coverage % (vs full scan)"))
+    scenes = list(dict.fromkeys((r["scene"], r["role"]) for r in rows))
+    policies = list(dict.fromkeys(r["policy"] for r in rows))
+    width = 0.8 / len(policies)
     fig = Figure(figsize=(4.4 * len(panels), 4.2))
     axes = fig.subplots(1, len(panels))
-    x = list(range(len(rows)))
     for ax, (key, paper_key, scale, title) in zip(axes, panels):
-        ax.bar(x, [r[key] for r in rows], yerr=[r[f"{key}_std"] for r in rows], capsize=4, color="tab:blue",
-               label="ours")
-        marked = [(i, scale * r["paper"][paper_key]) for i, r in enumerate(rows) if paper_key in r["paper"]]
+        for k, policy in enumerate(policies):
+            mine = [(scenes.index((r["scene"], r["role"])), r) for r in rows if r["policy"] == policy]
+            ax.bar([i + (k - (len(policies) - 1) / 2) * width for i, _ in mine], [r[key] for _, r in mine],
+                   width, yerr=[r[f"{key}_std"] for _, r in mine], capsize=3, color=f"C{k}",
+                   label=f"ours: {policy}")
+        paper = {(r["scene"], r["role"]): r["paper"] for r in rows}  # the same for every policy
+        marked = [(i, scale * paper[s][paper_key]) for i, s in enumerate(scenes) if paper_key in paper[s]]
         if marked:
             ax.plot(*zip(*marked), "D", color="tab:red", label="paper")
-        ax.set_xticks(x, [f"{r['scene']}\n{r['role']}" for r in rows], fontsize=7)
+        ax.set_xticks(range(len(scenes)), [f"{scene}\n{role}" for scene, role in scenes], fontsize=7)
         ax.set_title(title, fontsize=10)
         ax.legend(fontsize=8)
     fig.suptitle("Fig. 1 and Fig. 7: one pass around the target")

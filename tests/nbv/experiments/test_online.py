@@ -39,8 +39,9 @@ def test_online_report_from_saved_runs(tmp_path):
                 turns = (1.0, 0.5) if label == "random" and seed == 1 else (1.0, 2.0)  # one turn back
                 save_run(root / "views13" / f"{label}-seed{seed}", 13, values[seed], planning[label],
                          (2.0, 2.0 + seed + (scene == "random:5")), turns)
-        for seed in (0, 1):
+        for seed in (0, 1):  # every policy flies one pass: the second (the paper's, say) two views more
             save_run(root / "onepass" / f"policy-shipped-seed{seed}", 10 + seed, 0.75, 0.4)
+            save_run(root / "onepass" / f"policy-seed1-seed{seed}", 12 + seed, 0.65, 0.4)
     config = OnlineConfig(out=tmp_path, scenes=("alpine_chalet", "random:5"), seeds=(0, 1),
                           policies=("policy", f"policy:{tmp_path / 'seed1' / 'policy.pt'}"),
                           baselines=("random", "circle", "greedy"))
@@ -52,12 +53,14 @@ def test_online_report_from_saved_runs(tmp_path):
             f"policy:{tmp_path}/seed1/policy.pt --baselines random circle greedy --seeds 0 1 --views 13 "
             "--out DIR`") in text
     assert "- planning speed-up over greedy (without the simulated camera): 100x" in text
-    spread = ("- spread over the 2 policies (training seeds): 10.0 points "
+    spread = ("- spread over the 2 policies: 10.0 points "
               "(policy-shipped 85.0, policy-seed1 75.0)")
     assert spread in text
     assert "policy-shipped 1.50 / 0.50" in text
     row = next(line for line in text.splitlines() if line.startswith("| random:5 (policy-shipped)"))
     assert row == "| random:5 (policy-shipped) | 10.5 | 80.0 | 3.00 | 0.80 | 75.0 | 4.0 |"
+    row = next(line for line in text.splitlines() if line.startswith("| random:5 (policy-seed1)"))
+    assert row == "| random:5 (policy-seed1) | 12.5 | 70.0 | 3.00 | 0.80 | 65.0 | 4.0 |"
     assert "| random:5 | 5.5 / 0.0 | 5.5 / 0.0 | 5.5 / 0.5 | 5.5 / 0.0 | 5.5 / 0.0 |" in text  # m / reversals
     assert "| **mean** | **5.0 / 0.0** | **5.0 / 0.0** | **5.0 / 0.5** | **5.0 / 0.0** |" in text
     assert "| paper Fig. 7 (alpine_chalet) | - | - | 9.47 | 1.01 | - |" in text
@@ -84,11 +87,13 @@ def test_online_hands_every_run_of_every_building_to_the_executor_at_once(tmp_pa
     stages = [comparison_tasks(comparison) for comparison in comparisons(config)]
     references = unique_tasks([task for refs, _ in stages for task in refs])
     runs = unique_tasks([task for _, plans in stages for task in plans])
-    # one reference per building (both protocols share it); the policy and the registry's 5 compared
-    # baselines (random, circle, orbit, orbit2, greedy) x 2 seeds at 13 views, + one pass
+    # one reference per building (both protocols share it); the two policies (the default's, the paper's)
+    # and the registry's 5 compared baselines (random, circle, orbit, orbit2, greedy) x 2 seeds at 13 views,
+    # + each policy's one pass
     assert config.baselines == ("random", "circle", "orbit", "orbit2", "greedy")
     assert [task.name for task in references] == ["full-scan reference of alpine_chalet",
                                                   "full-scan reference of random:5"]
-    assert len(runs) == 2 * (6 * 2 + 2)
-    assert runs[-1].name == f"policy-shipped-seed1 in {tmp_path}/random_5/onepass"
-    assert runs[-1].result == tmp_path / "random_5" / "onepass" / "policy-shipped-seed1" / "plan.json"
+    assert config.policies == ("policy", "policy-paper")
+    assert len(runs) == 2 * (7 * 2 + 2 * 2)
+    assert runs[-1].name == f"policy-paper-seed1 in {tmp_path}/random_5/onepass"
+    assert runs[-1].result == tmp_path / "random_5" / "onepass" / "policy-paper-seed1" / "plan.json"

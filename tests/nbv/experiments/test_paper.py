@@ -23,6 +23,11 @@ def test_sec7_is_views_saved_and_error_change_against_the_full_scan():
                                "lower_hausdorff_pct": -5.0}
 
 
+def test_tables_need_a_policy():
+    with pytest.raises(ValueError, match="at least one policy"):
+        PaperConfig(policies=())
+
+
 def test_parts_run_in_order_whatever_the_flags_say():
     assert PaperConfig(part=("budget", "table2")).parts == ("table2", "budget")
     assert PaperConfig().parts == ("table2", "sec7", "episodes", "budget")
@@ -39,12 +44,13 @@ def test_tables_quick_writes_every_part_and_the_index(tmp_path):
         assert (tmp_path / name).is_file(), name
     assert "paper Sec. VII | 70.6" in (tmp_path / "sec7.md").read_text()
     episodes = (tmp_path / "fig1_fig7.md").read_text()
-    assert "test_building: Fig. 1 (trained on), ours" in episodes
+    assert "test_building: Fig. 1 (trained on), ours (policy-shipped)" in episodes
+    assert "test_building: Fig. 1 (trained on), ours (policy-paper)" in episodes  # the paper's method beside
     assert "paper Fig. 1 | 13 | 94.60 | 2.78" in episodes
     budget = json.loads((tmp_path / "budget" / "budget.json").read_text())
     rows = {r["planner"]: r for r in budget["rows"]["coverage"] if r["scene"] == "test_building"}
     assert set(rows) == {"random", "circle", "orbit", "orbit2", "greedy", "infogain", "policy-shipped",
-                         "oracle"}
+                         "policy-paper", "oracle"}
     for planner, row in rows.items():  # the oracle bounds the reported coverage at every budget (one seed)
         assert all(o >= m for o, m in zip(rows["oracle"]["mean"], row["mean"])), planner
     index = (tmp_path / "README.md").read_text()

@@ -14,7 +14,14 @@ from nbv.features.config import FeatureConfig
 from nbv.planning.config import PlanSettings
 from nbv.planning.planners import CirclePlanner, GreedyBoVPlanner, HemispherePlanner, RandomPlanner
 from nbv.planning.policy import PolicyPlanner
-from nbv.planning.registry import SHIPPED_POLICY, entry, make_planner, planner_label, split_spec
+from nbv.planning.registry import (
+    SHIPPED_PAPER_POLICY,
+    SHIPPED_POLICY,
+    entry,
+    make_planner,
+    planner_label,
+    split_spec,
+)
 from nbv.planning.world import PlanningWorld
 from nbv.rl.builders import make_loss_module, make_optimizers, make_replay_buffer, make_sac_agent
 from nbv.rl.checkpoint import CheckpointError, save_checkpoint
@@ -189,5 +196,31 @@ def test_shipped_policy_is_the_default_training_command_and_plans():
     planner = make_planner("policy", PLAN)
     assert isinstance(planner, PolicyPlanner) and planner.env_config.bov.elevation_bands == 2
     world = PlanningWorld(replace(planner.env_config, scenes=TEST_BUILDING, lattice=LatticeConfig()))
+    views = planner.plan(world, 3)
+    assert len(views) == 3 and all(in_ranges(v, world.env) for v in views)
+
+
+PAPER_COMMAND = ["--preset", "paper", "--lattice", "--width", "160", "--height", "120", "--spp", "4",
+                 "--feature-backend", "opencv", "--out", "runs/paper"]
+"""nbv/planning/shipped/paper/README.md's command: the paper's Table 1, rendered and described as the default
+is in training (a lattice at 160x120, 4 spp, OpenCV SIFT), so the two differ in their method alone."""
+
+
+def test_paper_policy_is_the_paper_training_command_and_plans():
+    from common.provenance import config_record
+    from nbv.cli.train import parse_train
+    from nbv.rl.train import with_defaults
+
+    raw = torch.load(SHIPPED_PAPER_POLICY, weights_only=True)
+    assert raw["format"] == "nbv-sac-policy" and SHIPPED_PAPER_POLICY.stat().st_size < 5_000_000
+    shipped = with_defaults(json.loads(raw["config"]))
+    paper = config_record(parse_train(PAPER_COMMAND))
+    for group in ("env", "reward", "collector", "replay_buffer", "optim", "network", "validation", "members"):
+        assert shipped[group] == paper[group], group  # the README's command retrains it
+    planner = make_planner("policy-paper", PLAN)
+    env = planner.env_config  # Table 1: absolute actions, azimuth-only ranges, the Bag of Views reward alone
+    assert (env.action_mode, env.bov.elevation_bands, env.episode_views) == ("absolute", 1, 0)
+    assert shipped["reward"]["coverage"] == 0 and shipped["optim"]["reward_scale"] == 1
+    world = PlanningWorld(replace(env, scenes=TEST_BUILDING, lattice=LatticeConfig()))
     views = planner.plan(world, 3)
     assert len(views) == 3 and all(in_ranges(v, world.env) for v in views)

@@ -17,7 +17,7 @@ from scenes.spec import SceneSpec
 
 ROOT = Path(__file__).resolve().parents[3]
 SHIPPED = ("random", "circle", "orbit", "orbit2", "greedy", "hemisphere", "infogain", "policy",
-           "policy-sample", "oracle")
+           "policy-sample", "policy-paper", "oracle")
 
 
 class ToyPlanner(Planner):
@@ -50,6 +50,11 @@ def test_every_shipped_planner_has_one_entry_and_a_factory_that_makes_it():
         assert isinstance(make_planner(name, PlanSettings()), Planner)
     assert [e.name for e in entries() if e.reads_truth] == ["oracle"]
     assert [e.name for e in entries() if e.checkpoint] == ["policy", "policy-sample"]
+    paper = make_planner("policy-paper", PlanSettings())  # the paper preset's shipped actor, on its mode
+    assert paper.checkpoint == registry.SHIPPED_PAPER_POLICY and not paper.sample
+    assert planner_label("policy-paper") == "policy-paper"
+    with pytest.raises(ValueError, match="unknown planner"):
+        entry("policy-paper:runs/x/policy.pt")  # it flies the shipped file and takes none
 
 
 def test_settings_reach_the_planner_and_specs_resolve():
@@ -87,7 +92,8 @@ def test_the_docs_list_the_registrys_planners():
 def test_the_study_lists_come_from_the_registry():
     from nbv.experiments.budget import PLANNERS, REPLANNED
 
-    assert PLANNERS == ("random", "circle", "orbit", "orbit2", "greedy", "infogain", "policy", "oracle")
+    assert PLANNERS == ("random", "circle", "orbit", "orbit2", "greedy", "infogain", "policy", "policy-paper",
+                        "oracle")
     assert REPLANNED == ("circle", "orbit", "orbit2", "oracle")
 
 

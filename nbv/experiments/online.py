@@ -37,7 +37,7 @@ from nbv.experiments.planner_study import run_studies, scene_folder
 from nbv.experiments.sfm_columns import sfm_table
 from nbv.fanout.config import ExecutorConfig
 from nbv.planning.config import PlanSettings
-from nbv.planning.registry import compared_planners, planner_label
+from nbv.planning.registry import SHIPPED_POLICIES, compared_planners, planner_label
 from nbv.recon.config import MetricsConfig
 from nbv.sfm.config import SfmOption
 from nbv.viz.figures import plot_seed_scores
@@ -57,7 +57,7 @@ class OnlineConfig(SfmOption):
     """Folder of the per-building comparisons and of online.{md,json,png}."""
     scenes: tuple[str, ...] = HELD_OUT
     """Buildings to plan for (held out from training)."""
-    policies: tuple[str, ...] = ("policy", "policy-paper")
+    policies: tuple[str, ...] = SHIPPED_POLICIES
     """Policies to evaluate on their mode (policy: the shipped default; policy-paper: the paper preset's, so
     the paper's method stands beside ours; policy:CHECKPOINT for others); the first is the one the margins
     describe. Each flies the one-pass protocol too."""

@@ -32,7 +32,7 @@ from nbv.experiments.paper_numbers import FIG1_NBV, FIG7_GENERALISATION, SEC7_SU
 from nbv.experiments.planner_study import scene_folder
 from nbv.experiments.table2 import TablesConfig, run_tables
 from nbv.planning.config import PlanSettings
-from nbv.planning.registry import budget_planners, planner_label
+from nbv.planning.registry import SHIPPED_POLICIES, budget_planners, planner_label
 from nbv.recon.config import MetricsConfig, OccupancyConfig
 from nbv.sfm.config import SfmOption
 from nbv.viz.paper import plot_episodes
@@ -58,7 +58,7 @@ class PaperConfig(TablesConfig, SfmOption):
     part: Annotated[tuple[Part, ...], UseAppendAction] = ()
     """Run only these parts (repeat --part; default: all): table2, sec7 (needs table2's files), episodes,
     budget."""
-    policies: tuple[str, ...] = ("policy", "policy-paper")
+    policies: tuple[str, ...] = SHIPPED_POLICIES
     """The policies of Fig. 1 and Fig. 7, rows of their own (policy: the shipped default; policy-paper: the
     paper preset's, so the paper's method stands beside ours); the first is the budget curves' `policy`."""
     fig1_scene: str = "medieval_tavern"

@@ -27,6 +27,9 @@ learning curves beside it): what `policy` and `policy-sample` without a checkpoi
 SHIPPED_PAPER_POLICY = SHIPPED_POLICY.parent / "paper" / "policy.pt"
 """The policy of `nbv train --preset paper` (the paper's Table 1 method, README and config beside it): what
 `policy-paper` flies, so every study can show the paper's method beside the default (issue 26)."""
+SHIPPED_POLICIES = ("policy", "policy-paper")
+"""The shipped policies as planner specs, the default first: what `nbv online` and `nbv tables` (Fig. 1 /
+Fig. 7) report side by side unless told otherwise."""
 
 
 @dataclass(frozen=True)

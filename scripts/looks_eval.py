@@ -21,7 +21,6 @@ Validation buildings only: the script refuses held-out ones (`scenes.family_spli
 from __future__ import annotations
 
 import argparse
-import itertools
 import json
 import sys
 from pathlib import Path
@@ -32,8 +31,8 @@ from tqdm import tqdm
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import git_commit
 from nbv.features.source import ViewSource
-from nbv.flight.path import shell_position
 from nbv.flight.record import flight_record
+from nbv.flight.spread import pair_spreads_m
 from nbv.planning.base import Planner
 from nbv.planning.config import PlanSettings
 from nbv.planning.policy import PolicyPlanner
@@ -81,12 +80,9 @@ class Scorer:
 
 def spread_m(runs: dict[tuple[str, int], dict], scenes: list[str], seeds: list[int]) -> float:
     """Mean distance between the i-th camera positions on two buildings from the same start, metres."""
-    gaps = []
-    for seed, (a, b) in itertools.product(seeds, itertools.combinations(scenes, 2)):
-        pa = [shell_position(*Viewpoint(*v).as_array()) for v in runs[a, seed]["viewpoints"]]
-        pb = [shell_position(*Viewpoint(*v).as_array()) for v in runs[b, seed]["viewpoints"]]
-        gaps.append(float(np.mean([np.linalg.norm(x - y) for x, y in zip(pa, pb)])))
-    return float(np.mean(gaps))
+    paths = {s: {seed: [Viewpoint(*v) for v in runs[s, seed]["viewpoints"]] for seed in seeds}
+             for s in scenes}
+    return float(np.mean(list(pair_spreads_m(paths).values())))
 
 
 def score_scene(scorer: Scorer, planner: Planner, env: EnvConfig, scene: str, seeds: list[int],

@@ -118,7 +118,8 @@ def compare_planners(config: CompareConfig) -> str:
     for run in run_study(config.study()):
         doc = run.plan()
         runs.append({"planner": run.label, "seed": run.seed,
-                     **{k: doc[k] for k in ("views", "gt", "reference", "planning_s", "deciding_s")},
+                     **{k: doc[k] for k in ("views", "gt", "reference", "planning_s", "deciding_s",
+                                             "viewpoints")},
                      **prefix_flight(doc), **({"sfm": sfm_entry(doc["sfm"])} if config.sfm else {})})
     scene = config.scene.scene
     table = comparison_table(runs, scene, config.settings.metrics.threshold_cm)

@@ -4,13 +4,16 @@ Two protocols per building, each an `nbv compare` folder (runs already there are
 - `views13/`: every planner captures 13 views (the paper's Fig. 1 count), one run per seed
   (start view, renders, random draws);
 - `onepass/`: each policy stops after one pass around the target, its own view count, as in
-  the paper, scored against the full scan beside Fig. 1 and Fig. 7.
+  the paper, scored against the full scan beside Fig. 1 and Fig. 7;
+- `views13-blank/` (`--blank`, on by default): each policy's 13 views again with every captured image
+  replaced by a blank one, for the acceptance's test that the policy looks.
 
 `online.md` gives, per building and overall, the mean coverage of the true surface at 13 views
 and the policy's margins over random, circle and greedy Bag of Views with its planning speed-up
 over greedy (issue 11's acceptance figures), the metres each planner flies and its azimuth
-reversals (`nbv.flight`), then the one-pass table. The buildings default to
-the held-out ones: nothing here trains or tunes anything.
+reversals (`nbv.flight`), then the one-pass table and issue 26's acceptance table
+(`nbv.experiments.online_acceptance`). The buildings default to the held-out ones: nothing here
+trains or tunes anything.
 
 Every comparison is a `PlannerStudy` preset (`nbv.experiments.planner_study`) under the one nested
 `PlanSettings`, so every `nbv plan` knob is an `nbv online` flag. Every (planner, seed, building, protocol)
@@ -22,7 +25,7 @@ by side as well as the seeds.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Annotated
 
@@ -32,19 +35,23 @@ from tyro.conf import arg
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import config_record, git_commit
 from nbv.experiments.compare import CompareConfig, compare_planners
+from nbv.experiments.online_acceptance import acceptance_checks, acceptance_section
 from nbv.experiments.paper_numbers import FIG1_NBV, FIG7_GENERALISATION
 from nbv.experiments.planner_study import run_studies, scene_folder
 from nbv.experiments.sfm_columns import sfm_table
 from nbv.fanout.config import ExecutorConfig
 from nbv.planning.config import PlanSettings
-from nbv.planning.registry import SHIPPED_POLICIES, compared_planners, planner_label
+from nbv.planning.registry import SHIPPED_POLICIES, compared_planners, entry, planner_label
 from nbv.recon.config import MetricsConfig
 from nbv.sfm.config import SfmOption
 from nbv.viz.figures import plot_seed_scores
 from scenes.spec import SceneSpec
 
-HELD_OUT = ("alpine_chalet", "imperial_temple", "random:0", "random:5", "random:10")
-"""The evaluation buildings: both held-out presets and three test-split random buildings."""
+HELD_OUT = ("alpine_chalet", "imperial_temple", "random:0", "random:5", "random:10", "family:0", "family:5",
+            "family:15")
+"""The evaluation buildings: both held-out presets, three test-split random buildings and three test-split
+family buildings (`scenes.family_splits`): the first of the held-out trait (a walled compound) and the first
+of two seen traits whose best orbits differ most (a tower, a courtyard)."""
 OUTPUTS = ("online.md", "online.json", "online.png")
 """What `nbv online` writes into `--out` together, beside the per-building folders."""
 
@@ -70,6 +77,9 @@ class OnlineConfig(SfmOption):
     """The fixed view budget."""
     one_pass: bool = True
     """Also run the paper's protocol: the first policy's own episode (one pass), against the full scan."""
+    blank: bool = True
+    """Also fly each policy's fixed budget with every captured image blank (does the policy look?); planners
+    that read no image (`--policies random`, say) are not flown again."""
     settings: Annotated[PlanSettings, arg(name="")] = PlanSettings(metrics=MetricsConfig(n_points=200_000))
     """What every run shares (`nbv plan`'s settings; reconstructions scored on 200k points per surface, as
     `nbv demo` and `nbv tables`)."""
@@ -94,6 +104,11 @@ def comparisons(config: OnlineConfig) -> list[CompareConfig]:
                                    planners=(*config.policies, *config.baselines)))
         if config.one_pass:
             found.append(CompareConfig(**common, planners=config.policies, out=folder / "onepass"))
+        seeing = tuple(p for p in config.policies if "blank_images" in entry(p).settings)
+        if config.blank and seeing:
+            blank = replace(config.settings, blank_images=True)
+            found.append(CompareConfig(**(common | {"settings": blank}), views=config.views, planners=seeing,
+                                       out=folder / f"views{config.views}-blank"))
     return found
 
 
@@ -102,13 +117,15 @@ def run_online(config: OnlineConfig) -> str:
     out = Path(config.out)
     compared = comparisons(config)
     run_studies([comparison.study() for comparison in compared], config.executor)
-    budget, one_pass = {}, {}
+    budget, one_pass, blank = {}, {}, {}
     for comparison in compared:
         compare_planners(comparison)
-        found = budget if comparison.views is not None else one_pass
+        found = (blank if comparison.settings.blank_images else budget if comparison.views is not None
+                 else one_pass)
         found[comparison.scene.scene] = _runs(comparison.out)
     policy = planner_label(config.policies[0])
-    text = online_report(budget, one_pass, policy, config)
+    checks = acceptance_checks(budget, blank or None, [planner_label(spec) for spec in config.policies])
+    text = online_report(budget, one_pass, policy, config, checks)
     coverage = {label: [np.mean(_values(runs[label], "gt", "coverage")) * 100 for runs in budget.values()]
                 for label in next(iter(budget.values()))}
     record = config_record(config, omit=("executor",))
@@ -117,8 +134,8 @@ def run_online(config: OnlineConfig) -> str:
         plot_seed_scores(coverage, folder / "online.png",
                          f"coverage % of the true surface, {config.views} views",
                          f"mean over {len(config.seeds)} seeds; one dot per building")
-        write_json(folder / "online.json", {"commit": git_commit(), "config": record,
-                                            "budget": budget, "one_pass": one_pass})
+        write_json(folder / "online.json", {"commit": git_commit(), "config": record, "budget": budget,
+                                            "one_pass": one_pass, "blank": blank, "acceptance": checks})
     return text
 
 
@@ -126,7 +143,7 @@ def rerun_command(config: OnlineConfig) -> str:
     """The `nbv online` command line that re-runs `config`'s evaluation (its output folder left as DIR)."""
     return (f"nbv online --scenes {' '.join(config.scenes)} --policies {' '.join(config.policies)} "
             f"--baselines {' '.join(config.baselines)} --seeds {' '.join(map(str, config.seeds))} "
-            f"--views {config.views} --out DIR")
+            f"--views {config.views}{'' if config.blank else ' --no-blank'} --out DIR")
 
 
 def _runs(folder: Path) -> dict[str, list[dict]]:
@@ -142,8 +159,9 @@ def _values(runs: list[dict], against: str, key: str) -> list[float]:
 
 
 def online_report(budget: dict[str, dict[str, list[dict]]], one_pass: dict[str, dict[str, list[dict]]],
-                  policy: str, config: OnlineConfig) -> str:
-    """The Markdown report: 13-view coverage per building with the policy's margins, then one pass."""
+                  policy: str, config: OnlineConfig, checks: dict[str, list[dict]]) -> str:
+    """The Markdown report: 13-view coverage per building with the policy's margins, then one pass, then
+    the acceptance checks (`checks`, by policy)."""
     labels = list(next(iter(budget.values())))
     rows, means = [], {label: [] for label in labels}
     for scene, runs in budget.items():
@@ -186,6 +204,7 @@ def online_report(budget: dict[str, dict[str, list[dict]]], one_pass: dict[str, 
     if one_pass:
         lines += ["", "## One pass around the target (the paper's protocol), against the full 288-view scan",
                   "", _one_pass_table(one_pass, policies)]
+    lines += acceptance_section(checks, len(budget))
     if config.sfm:
         lines += _sfm_section(budget, one_pass, config.views)
     return "\n".join(lines) + "\n"

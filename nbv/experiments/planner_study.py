@@ -149,11 +149,13 @@ def plan_config(study: PlannerStudy, scene: str, planner: str, seed: int, views:
 
 
 def reference_units(study: PlannerStudy) -> list[Task]:
-    """Each building's full-scan reference (cached, so always run), when the runs are scored against it."""
+    """Each building's full-scan reference (cached, so always run), when the runs are scored against it; one
+    task whether the policies see blank images or not, so studies differing in that alone share it."""
     if not study.settings.full_scan:
         return []
+    settings = replace(study.settings, blank_images=False)
     return [Task(f"full-scan reference of {scene}", reference_mesh,
-                 {"scene": scene_spec(study, scene), "settings": study.settings}) for scene in study.scenes]
+                 {"scene": scene_spec(study, scene), "settings": settings}) for scene in study.scenes]
 
 
 def plan_result(config: PlanConfig) -> Path:

@@ -42,6 +42,8 @@ def test_online_report_from_saved_runs(tmp_path):
         for seed in (0, 1):  # every policy flies one pass: the second (the paper's, say) two views more
             save_run(root / "onepass" / f"policy-shipped-seed{seed}", 10 + seed, 0.75, 0.4)
             save_run(root / "onepass" / f"policy-seed1-seed{seed}", 12 + seed, 0.65, 0.4)
+            for label in ("policy-shipped", "policy-seed1"):  # blind, the shipped one covers 15 points less
+                save_run(root / "views13-blank" / f"{label}-seed{seed}", 13, 0.7, 0.5)
     config = OnlineConfig(out=tmp_path, scenes=("alpine_chalet", "random:5"), seeds=(0, 1),
                           policies=("policy", f"policy:{tmp_path / 'seed1' / 'policy.pt'}"),
                           baselines=("random", "circle", "greedy"))
@@ -64,9 +66,16 @@ def test_online_report_from_saved_runs(tmp_path):
     assert "| random:5 | 5.5 / 0.0 | 5.5 / 0.0 | 5.5 / 0.5 | 5.5 / 0.0 | 5.5 / 0.0 |" in text  # m / reversals
     assert "| **mean** | **5.0 / 0.0** | **5.0 / 0.0** | **5.0 / 0.5** | **5.0 / 0.0** |" in text
     assert "| paper Fig. 7 (alpine_chalet) | - | - | 9.47 | 1.01 | - |" in text
+    assert "## Acceptance (issue 26): each policy against the tuned orbit on 2 buildings" in text
+    assert "| coverage lost with blank images, points | >= 3.0 | +15.0 (yes) | +5.0 (yes) |" in text
+    no_orbit = "| mean coverage minus the tuned orbit's, points | >= +3.0 | n/a (no) | n/a (no) |"
+    assert no_orbit in text
+    assert "| path spread, closest pair of buildings, m | >= 0.20 | 0.00 (no) | 0.00 (no) |" in text
     assert (tmp_path / "online.md").read_text() == text
     saved = json.loads((tmp_path / "online.json").read_text())
     assert saved["config"]["seeds"] == [0, 1] and len(saved["budget"]["random:5"]["greedy"]) == 2
+    assert len(saved["blank"]["random:5"]["policy-seed1"]) == 2 and set(saved["acceptance"]) == {
+        "policy-shipped", "policy-seed1"}
     assert Image.open(tmp_path / "online.png").size[0] > 300
     assert scene_folder("random:5") == "random_5"
 
@@ -89,11 +98,14 @@ def test_online_hands_every_run_of_every_building_to_the_executor_at_once(tmp_pa
     runs = unique_tasks([task for _, plans in stages for task in plans])
     # one reference per building (both protocols share it); the two policies (the default's, the paper's)
     # and the registry's 5 compared baselines (random, circle, orbit, orbit2, greedy) x 2 seeds at 13 views,
-    # + each policy's one pass
+    # + each policy's one pass + each policy's 13 views with blank images
     assert config.baselines == ("random", "circle", "orbit", "orbit2", "greedy")
     assert [task.name for task in references] == ["full-scan reference of alpine_chalet",
                                                   "full-scan reference of random:5"]
     assert config.policies == ("policy", "policy-paper")
-    assert len(runs) == 2 * (7 * 2 + 2 * 2)
-    assert runs[-1].name == f"policy-paper-seed1 in {tmp_path}/random_5/onepass"
-    assert runs[-1].result == tmp_path / "random_5" / "onepass" / "policy-paper-seed1" / "plan.json"
+    assert len(runs) == 2 * (7 * 2 + 2 * 2 + 2 * 2)
+    assert runs[-1].name == f"policy-paper-seed1 in {tmp_path}/random_5/views13-blank"
+    assert runs[-1].result == tmp_path / "random_5" / "views13-blank" / "policy-paper-seed1" / "plan.json"
+    blank = [c for c in comparisons(config) if c.settings.blank_images]
+    assert [c.planners for c in blank] == [config.policies] * 2 and all(c.views == 13 for c in blank)
+    assert len(comparisons(OnlineConfig(out=tmp_path, scenes=("random:5",), blank=False))) == 2

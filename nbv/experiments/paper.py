@@ -211,7 +211,9 @@ def episodes_markdown(rows: list[dict[str, Any]], config: PaperConfig) -> str:
                      paper(p.get("chamfer_cm")), "-"])
     return "\n".join([
         f"# Fig. 1 and Fig. 7: the policies' one pass around the target (commit {git_commit()})", "",
-        f"{', '.join(f'`{p}`' for p in config.policies)} (the paper preset's policy is `policy-paper`), each "
+        f"{', '.join(f'`{p}`' for p in config.policies)}"
+        + (" (the paper preset's policy is `policy-paper`)" if "policy-paper" in config.policies else "")
+        + ", each "
         "acting on its mode until its episode ends (one pass, its own view count), seeds "
         f"{', '.join(map(str, config.episode_seeds))}; 'ref' is the reconstruction of the full hemisphere "
         "scan, as in the paper; 'gt' the ground-truth mesh. Paper rows are the paper's own numbers "
@@ -270,6 +272,8 @@ class Result(NamedTuple):
     command: str
 
 
+LOOKS_EVAL = "scripts/looks_eval.py (commands in the file)"
+"""How the rounds of issue 26's choice were scored."""
 INDEX = (
     Result("table2.md", "table2.json", "Table 2 (views kept, Hausdorff, Chamfer per N and W)", "make tables"),
     Result("fig6/", "table2.json", "Fig. 6 heat maps: the grid's corners against the full scan (first seed)",
@@ -281,6 +285,9 @@ INDEX = (
            "make tables"),
     Result("online/online.md", "online/online.json", "the shipped policies (ours, the paper preset's) "
            "against the baselines, 13 views, five held-out buildings", "nbv online (command in the file)"),
+    Result("online/acceptance/online.md", "online/acceptance/online.json", "issue 26's acceptance, check by "
+           "check: the shipped policies against random views and the tuned orbits, with blank images, on "
+           "eight held-out buildings (three of the trait family)", "nbv online (command in the file)"),
     Result("ablations/README.md", "ablations/ablations.json", "rendering-quality ablations, one axis at a "
            "time", "make ablations"),
     Result("planners/README.md", "planners/comparison.json", "early planner comparison on the held-out "
@@ -294,17 +301,42 @@ INDEX = (
            "of 32, learning rate 2e-4", "scripts/select_defaults.py --round 3"),
     Result("selection/round4/README.md", "selection/round4/selection.json", "its fourth round: a coverage "
            "term in the reward", "scripts/select_defaults.py --round 4"),
+    Result("selection/round5/README.md", "selection/round5/results.json", "its fifth round: the Bag of "
+           "Views observation and the trait family (issue 26)", LOOKS_EVAL),
+    Result("selection/round6/README.md", "selection/round6/results.json", "its sixth round: orbit actions, "
+           "a flight term, no poses: none looks", LOOKS_EVAL),
+    Result("selection/round7/README.md", "selection/round7/results.json", "its seventh round: students of "
+           "a teacher that reads the true surface", LOOKS_EVAL),
+    Result("selection/round8/README.md", "selection/round8/results.json", "its eighth round: a look map "
+           "of the directions flown", LOOKS_EVAL),
+    Result("selection/round9/README.md", "selection/round9/results.json", "its ninth round: students "
+           "without frames", LOOKS_EVAL),
     Result("selection/round1/selection.md", "selection/round1/selection.json", "its first round, before the "
            "lattice fix", "scripts/select_defaults.py --round 1"),
+    Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
+           "share, models, centre and rotation errors",
+           "python scripts/sfm_presets.py (commands in the file)"),
     Result("sfm/register_curve.md", "sfm/register_curve.json", "COLMAP registration per view count and "
            "resolution: the policy, the tuned orbit, random views", "scripts/sfm_register_curve.py"),
+    Result("sfm/links/register_curve.md", "sfm/links/register_curve.json", "the same for random and greedy "
+           "views kept linked by --min-matches 15", "scripts/sfm_register_curve.py --min-matches 15"),
+    Result("sfm/greedy/register_curve.md", "sfm/greedy/register_curve.json", "the same for greedy views "
+           "without the constraint", "scripts/sfm_register_curve.py"),
     Result("sfm/tiled/register_curve.md", "sfm/tiled/register_curve.json", "COLMAP registration per view "
            "count and resolution, on the tiled look: the policy, the tuned orbit, random views",
            "scripts/sfm_register_curve.py --scene medieval_tavern@tiled"),
+    Result("sfm/demo/results.md", "sfm/demo/results.json", "`nbv demo --sfm --min-matches 15`: the full, "
+           "refined and linked sets' registration, the view reductions, the online half",
+           "nbv demo --sfm --min-matches 15"),
+    Result("match_cosine/match_cosine.md", "match_cosine/match_cosine.json", "the match cosine c re-chosen "
+           "on the detailed look: views kept per Table 2 cell for c = 0.76 to 0.8",
+           "python scripts/match_cosine.py (command in the file)"),
     Result("captures/captures.md", "captures/captures.json", "the full scan as COLMAP and nerfstudio "
            "captures: kept-frame Jaccard against the scan's own", "scripts/capture_agreement.py"),
 )
 """Every result `README.md` may map, in its order."""
+TIMINGS_JSON = "timings.json"
+"""Each part's last wall seconds and commit (`part_timings`), kept beside README.md."""
 SEED_KEYS = ("episode_seeds", "seeds")
 """Where a result's seeds are recorded: its config's first key present (`episode_seeds` for Fig. 1/7)."""
 
@@ -317,6 +349,17 @@ def _provenance(doc: dict[str, Any], file: str) -> tuple[str, str]:
     return str(doc.get("commit", "-")), ", ".join(map(str, seeds)) if seeds else "-"
 
 
+def part_timings(out: Path, seconds: dict[str, float]) -> dict[str, dict]:
+    """Each part's wall seconds and commit, as last run: `out/timings.json` updated with this run's parts
+    (a run of some parts keeps the others' last figures; a `note` kept by hand goes with its part's next
+    run)."""
+    path = out / TIMINGS_JSON
+    timings = json.loads(path.read_text()) if path.is_file() else {}
+    timings |= {part: {"seconds": s, "commit": git_commit()} for part, s in seconds.items()}
+    write_json(path, timings)
+    return timings
+
+
 def write_index(out: Path, seconds: dict[str, float]) -> Path:
     """`out/README.md`: each result present in `out`, what it holds, the command, seeds and commit."""
     rows = []
@@ -324,12 +367,14 @@ def write_index(out: Path, seconds: dict[str, float]) -> Path:
         if (out / result.file.rstrip("/")).exists() and (out / result.record).is_file():
             commit, seeds = _provenance(json.loads((out / result.record).read_text()), result.file)
             rows.append([f"`{result.file}`", result.what, f"`{result.command}`", seeds, commit])
-    timing = ", ".join(f"{part} {s:.0f} s" for part, s in seconds.items())
+    timing = ", ".join(f"{part} {doc['seconds']:.0f} s (at {doc['commit']}"
+                       + (f"; {doc['note']}" if "note" in doc else "") + ")"
+                       for part, doc in part_timings(out, seconds).items())
     text = "\n".join([
         "# Results measured by this toolkit, beside the paper's", "",
         "Every number here was measured by our code in the run that wrote its file, at the commit given "
         "(the JSON beside each file holds every setting); the paper's numbers stand beside ours, labelled "
         "'paper'. `make tables` writes the first five rows in one run (`nbv tables --out paper_results`); "
-        f"its last run's parts took: {timing}.", "",
+        f"each part's last run took (2 shared cores): {timing}.", "",
         markdown_table(["file", "what", "written by", "seeds", "commit"], rows)])
     return write_text(out / "README.md", text)

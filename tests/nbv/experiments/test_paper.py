@@ -7,7 +7,8 @@ import sys
 import pytest
 from PIL import Image
 
-from nbv.experiments.paper import PaperConfig, sec7_summary
+from common.provenance import git_commit
+from nbv.experiments.paper import PaperConfig, sec7_summary, write_index
 
 
 def test_sec7_is_views_saved_and_error_change_against_the_full_scan():
@@ -21,6 +22,24 @@ def test_sec7_is_views_saved_and_error_change_against_the_full_scan():
     assert summary["b"] == {"fewer_views_pct": 50.0, "lower_chamfer_pct": 50.0, "lower_hausdorff_pct": 0.0}
     assert summary["mean"] == {"fewer_views_pct": 56.25, "lower_chamfer_pct": 25.0,
                                "lower_hausdorff_pct": -5.0}
+
+
+def test_the_index_maps_every_result_present_and_keeps_each_parts_last_timing(tmp_path):
+    (tmp_path / "table2.md").write_text("t")
+    (tmp_path / "table2.json").write_text(json.dumps({"commit": "abc1234", "config": {"seeds": [0, 1]}}))
+    round9 = tmp_path / "selection" / "round9"
+    round9.mkdir(parents=True)
+    (round9 / "README.md").write_text("r")
+    (round9 / "results.json").write_text(json.dumps({"commit": "def5678", "seeds": [0, 1, 2]}))
+    write_index(tmp_path, {"table2": 2294.4, "sec7": 1.0})
+    index = write_index(tmp_path, {"episodes": 728.0}).read_text()  # a later run of one part
+    commit = git_commit()
+    assert f"table2 2294 s (at {commit}), sec7 1 s (at {commit}), episodes 728 s (at {commit})" in index
+    row = ("| `table2.md` | Table 2 (views kept, Hausdorff, Chamfer per N and W) | `make tables` | 0, 1 "
+           "| abc1234 |")
+    assert row in index
+    assert "| `selection/round9/README.md` | its ninth round: students without frames |" in index
+    assert "`fig1_fig7.md`" not in index  # absent results are not listed
 
 
 def test_tables_need_a_policy():

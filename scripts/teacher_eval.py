@@ -8,6 +8,9 @@ teacher below the orbit is not worth imitating. Validation buildings only.
 
     python scripts/teacher_eval.py --flight-reward 0.5 --teacher-horizon 0 --teacher-discount 1 \
         --out paper_results/selection/round7/teacher --work WORK
+
+`--action-mode` and `--relative-step` give the teacher another action space than the `looks` preset's
+(relative steps of 1/8 of each range): `orbit` with a step of 1/6 holds the two tuned rings' path.
 """
 
 from __future__ import annotations
@@ -62,13 +65,20 @@ def main() -> None:
     parser.add_argument("--flight-reward", type=float, nargs="+", default=[0.5])
     parser.add_argument("--teacher-horizon", type=int, default=3, help="0: to the end of the budget")
     parser.add_argument("--teacher-discount", type=float, default=0.9)
+    parser.add_argument("--action-mode", choices=("relative", "orbit"), default=None,
+                        help="the teacher's action space (default: the looks preset's)")
+    parser.add_argument("--relative-step", type=float, default=None,
+                        help="its largest step per view, a fraction of each range (default: the preset's)")
     study_arguments(parser)
     args = parser.parse_args()
     refuse_held_out(args.scenes)
-    trained = looks_preset().env
-    planners = {"orbit": (make_planner("orbit", PlanSettings()), False),
-                "random": (make_planner("random", PlanSettings()), False)}
+    preset = looks_preset().env
+    trained = replace(preset, action_mode=args.action_mode or preset.action_mode,
+                      relative_step=args.relative_step or preset.relative_step)
+    planners = {name: (make_planner(name, PlanSettings()), False) for name in ("orbit", "orbit2", "random")}
     teacher = f"teacher_h{args.teacher_horizon}_d{args.teacher_discount:g}"
+    if trained != preset:
+        teacher += f"_{trained.action_mode}{trained.relative_step:.3g}"
     for w in args.flight_reward:
         terms = RewardConfig(imitation=1.0, flight=w, teacher_horizon=args.teacher_horizon,
                              teacher_discount=args.teacher_discount)

@@ -27,6 +27,7 @@ import json
 import multiprocessing
 import os
 import random
+import runpy
 import shutil
 import signal
 import subprocess
@@ -104,9 +105,8 @@ def _train_child(preset: str, out: Path) -> None:
     log = os.open(out.with_name(out.name + ".log"), os.O_WRONLY | os.O_CREAT | os.O_APPEND)
     os.dup2(log, 1)
     os.dup2(log, 2)
-    from nbv.cli import main
-
-    sys.exit(main(["train", *ARGS[preset], "--out", str(out)]))
+    sys.argv = ["nbv", "train", *ARGS[preset], "--out", str(out)]
+    runpy.run_module("nbv.cli", run_name="__main__", alter_sys=True)  # as `python -m nbv.cli`: it exits
 
 
 def finish(preset: str, out: Path, start: Callable = launch) -> None:

@@ -35,7 +35,7 @@ from tyro.conf import arg
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import config_record, git_commit
 from nbv.experiments.compare import CompareConfig, compare_planners
-from nbv.experiments.online_acceptance import acceptance_checks, acceptance_section
+from nbv.experiments.online_acceptance import acceptance_checks, acceptance_section, mean_coverage
 from nbv.experiments.paper_numbers import FIG1_NBV, FIG7_GENERALISATION
 from nbv.experiments.planner_study import run_studies, scene_folder
 from nbv.experiments.sfm_columns import sfm_table
@@ -126,8 +126,7 @@ def run_online(config: OnlineConfig) -> str:
     policy = planner_label(config.policies[0])
     checks = acceptance_checks(budget, blank or None, [planner_label(spec) for spec in config.policies])
     text = online_report(budget, one_pass, policy, config, checks)
-    coverage = {label: [np.mean(_values(runs[label], "gt", "coverage")) * 100 for runs in budget.values()]
-                for label in next(iter(budget.values()))}
+    coverage = {label: list(mean_coverage(budget, label).values()) for label in next(iter(budget.values()))}
     record = config_record(config, omit=("executor",))
     with atomic_folder(out, overwrite=True, outputs=OUTPUTS) as folder:
         write_text(folder / "online.md", text)
@@ -163,15 +162,9 @@ def online_report(budget: dict[str, dict[str, list[dict]]], one_pass: dict[str, 
     """The Markdown report: 13-view coverage per building with the policy's margins, then one pass, then
     the acceptance checks (`checks`, by policy)."""
     labels = list(next(iter(budget.values())))
-    rows, means = [], {label: [] for label in labels}
-    for scene, runs in budget.items():
-        row = [scene]
-        for label in labels:
-            value = 100 * float(np.mean(_values(runs[label], "gt", "coverage")))
-            means[label].append(value)
-            row.append(f"{value:.1f}")
-        rows.append(row)
-    overall = {label: float(np.mean(v)) for label, v in means.items()}
+    coverage = {label: mean_coverage(budget, label) for label in labels}
+    rows = [[scene, *(f"{coverage[label][scene]:.1f}" for label in labels)] for scene in budget]
+    overall = {label: float(np.mean(list(by.values()))) for label, by in coverage.items()}
     rows.append(["**mean**", *(f"**{overall[label]:.1f}**" for label in labels)])
     planning = {label: float(np.mean([r["planning_s"] for runs in budget.values() for r in runs[label]]))
                 for label in labels}

@@ -16,7 +16,7 @@ check whose planners were not run reads "n/a" and fails the whole.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -60,38 +60,38 @@ def policy_checks(runs: Runs, blank: Runs | None, policy: str) -> list[dict]:
     """The acceptance checks of one policy: each {check, bar, value, passed} (value None: not measurable)."""
     have = set.intersection(*(set(by) for by in runs.values()))
     mine = mean_coverage(runs, policy)
-    overall = float(np.mean(list(mine.values())))
     checks = []
 
-    def add(check: str, bar: str, value: float | None, passed: bool, shown: str | None = None) -> None:
-        checks.append({"check": check, "bar": bar, "value": value, "passed": value is not None and passed,
-                       "shown": shown})
+    def add(check: str, bar: str, value: float | None, ok: Callable[[float], bool], shown: str = "") -> None:
+        measured = value is not None
+        checks.append({"check": check, "bar": bar, "value": value, "passed": measured and ok(value),
+                       "shown": shown.format(value) if shown and measured else None})
 
     orbit = mean_coverage(runs, "orbit") if "orbit" in have else None
-    margin = overall - float(np.mean(list(orbit.values()))) if orbit else None
-    add("mean coverage minus the tuned orbit's, points", f">= +{ORBIT_MARGIN:.1f}", margin,
-        margin is not None and margin >= ORBIT_MARGIN)
-    worst = min(mine[s] - orbit[s] for s in mine) if orbit else None
-    add("worst building minus the tuned orbit, points", f">= {ORBIT_WORST:+.1f}", worst,
-        worst is not None and worst >= ORBIT_WORST)
+    add("mean coverage minus the tuned orbit's, points", f">= +{ORBIT_MARGIN:.1f}",
+        _mean(mine) - _mean(orbit) if orbit else None, lambda v: v >= ORBIT_MARGIN)
+    add("worst building minus the tuned orbit, points", f">= {ORBIT_WORST:+.1f}",
+        min(mine[s] - orbit[s] for s in mine) if orbit else None, lambda v: v >= ORBIT_WORST)
     add(*_random_check(runs, mine, have))
-    ratio = mean_flight(runs, policy) / mean_flight(runs, "orbit") if "orbit" in have else None
-    add("metres flown over the tuned orbit's", f"<= {FLIGHT_RATIO:.1f}x", ratio,
-        ratio is not None and ratio <= FLIGHT_RATIO, None if ratio is None else f"{ratio:.2f}x")
+    add("metres flown over the tuned orbit's", f"<= {FLIGHT_RATIO:.1f}x",
+        mean_flight(runs, policy) / mean_flight(runs, "orbit") if orbit else None,
+        lambda v: v <= FLIGHT_RATIO, "{:.2f}x")
     spreads = pair_spreads_m({scene: {r["seed"]: [Viewpoint(*v) for v in r["viewpoints"]] for r in by[policy]}
                               for scene, by in runs.items()}) if len(runs) > 1 else {}
-    closest = min(spreads.values()) if spreads else None
-    add("path spread, closest pair of buildings, m", f">= {SPREAD_M:.2f}", closest,
-        closest is not None and closest >= SPREAD_M, None if closest is None else f"{closest:.2f}")
+    add("path spread, closest pair of buildings, m", f">= {SPREAD_M:.2f}",
+        min(spreads.values()) if spreads else None, lambda v: v >= SPREAD_M, "{:.2f}")
     flown_blind = blank and all(policy in by for by in blank.values())
-    drop = overall - float(np.mean(list(mean_coverage(blank, policy).values()))) if flown_blind else None
-    add("coverage lost with blank images, points", f">= {BLANK_DROP:.1f}", drop,
-        drop is not None and drop >= BLANK_DROP)
+    add("coverage lost with blank images, points", f">= {BLANK_DROP:.1f}",
+        _mean(mine) - _mean(mean_coverage(blank, policy)) if flown_blind else None, lambda v: v >= BLANK_DROP)
     if "orbit2" in have:
-        beside = overall - float(np.mean(list(mean_coverage(runs, "orbit2").values())))
         checks.append({"check": "mean coverage minus the two tuned rings' (orbit2), points",
-                       "bar": "reported", "value": beside, "passed": None, "shown": None})
+                       "bar": "reported", "value": _mean(mine) - _mean(mean_coverage(runs, "orbit2")),
+                       "passed": None, "shown": None})
     return checks
+
+
+def _mean(by_building: Mapping[str, float]) -> float:
+    return float(np.mean(list(by_building.values())))
 
 
 def _random_check(runs: Runs, mine: dict[str, float], have: set[str]) -> tuple:
@@ -100,12 +100,12 @@ def _random_check(runs: Runs, mine: dict[str, float], have: set[str]) -> tuple:
              f"{ORACLE_GAP:g} above random)")
     bar = f">= +{RANDOM_MARGIN:.1f}"
     if "random" not in have:
-        return check, bar, None, False
+        return check, bar, None, bool
     rand = mean_coverage(runs, "random")
     oracle = mean_coverage(runs, "oracle") if "oracle" in have else {}
-    passed = [mine[s] >= oracle[s] - ORACLE_WITHIN if s in oracle and oracle[s] - rand[s] < ORACLE_GAP
-              else mine[s] - rand[s] >= RANDOM_MARGIN for s in mine]
-    return check, bar, min(mine[s] - rand[s] for s in mine), all(passed)
+    passed = all(mine[s] >= oracle[s] - ORACLE_WITHIN if s in oracle and oracle[s] - rand[s] < ORACLE_GAP
+                 else mine[s] - rand[s] >= RANDOM_MARGIN for s in mine)
+    return check, bar, min(mine[s] - rand[s] for s in mine), lambda _: passed
 
 
 def acceptance_checks(runs: Runs, blank: Runs | None, policies: Sequence[str]) -> dict[str, list[dict]]:

@@ -29,7 +29,7 @@ from nbv.fanout.config import ExecutorConfig
 from nbv.fanout.executor import run_stages
 from nbv.fanout.task import Task
 from nbv.planning.config import PlanConfig, PlanSettings
-from nbv.planning.plan import plan_scan, reference_mesh
+from nbv.planning.plan import plan_scan, reference_mesh, reference_settings
 from nbv.planning.registry import entry, planner_label
 from nbv.recon.fused_coverage import as_stored
 from nbv.recon.metrics import evaluate_surfaces, load_geometry
@@ -150,10 +150,10 @@ def plan_config(study: PlannerStudy, scene: str, planner: str, seed: int, views:
 
 def reference_units(study: PlannerStudy) -> list[Task]:
     """Each building's full-scan reference (cached, so always run), when the runs are scored against it; one
-    task whether the policies see blank images or not, so studies differing in that alone share it."""
+    task for every study with the settings it reads (`reference_settings`)."""
     if not study.settings.full_scan:
         return []
-    settings = replace(study.settings, blank_images=False)
+    settings = reference_settings(study.settings)
     return [Task(f"full-scan reference of {scene}", reference_mesh,
                  {"scene": scene_spec(study, scene), "settings": settings}) for scene in study.scenes]
 

@@ -89,6 +89,13 @@ def flown_seconds(seconds: float, rendered: int, flown: int) -> float:
     return seconds / rendered * min(rendered, flown) if rendered else 0.0
 
 
+def reference_settings(settings: PlanSettings) -> PlanSettings:
+    """What the full-scan reference of `reference_mesh` depends on (camera, rendering, fusion, a given
+    reference), the rest left at defaults: studies differing in any other knob share one reference."""
+    return PlanSettings(camera=settings.camera, render=settings.render, recon=settings.recon,
+                        reference=settings.reference)
+
+
 def reference_mesh(scene: SceneSpec, settings: PlanSettings, loaded: Scene | None = None) -> Path:
     """The full hemisphere scan's reconstruction (paper Sec. V-B), cached inside the cached scan's folder.
 

@@ -35,7 +35,12 @@ from tyro.conf import arg
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import config_record, git_commit
 from nbv.experiments.compare import CompareConfig, compare_planners
-from nbv.experiments.online_acceptance import acceptance_checks, acceptance_section, mean_coverage
+from nbv.experiments.online_acceptance import (
+    acceptance_checks,
+    acceptance_section,
+    mean_coverage,
+    per_building,
+)
 from nbv.experiments.paper_numbers import FIG1_NBV, FIG7_GENERALISATION
 from nbv.experiments.planner_study import run_studies, scene_folder
 from nbv.experiments.sfm_columns import sfm_table
@@ -212,17 +217,12 @@ def _sfm_section(budget: dict[str, dict[str, list[dict]]], one_pass: dict[str, d
 
 
 def _flight_table(budget: dict[str, dict[str, list[dict]]], labels: list[str]) -> str:
-    rows, means = [], {label: [] for label in labels}
-    for scene, runs in budget.items():
-        row = [scene]
-        for label in labels:
-            flight = (float(np.mean([r["flight_m"] for r in runs[label]])),
-                      float(np.mean([r["azimuth_reversals"] for r in runs[label]])))
-            means[label].append(flight)
-            row.append(f"{flight[0]:.1f} / {flight[1]:.1f}")
-        rows.append(row)
-    overall = {label: np.mean(means[label], axis=0) for label in labels}
-    rows.append(["**mean**", *(f"**{overall[label][0]:.1f} / {overall[label][1]:.1f}**" for label in labels)])
+    flight = {label: per_building(budget, label, lambda r: r["flight_m"]) for label in labels}
+    reversals = {label: per_building(budget, label, lambda r: r["azimuth_reversals"]) for label in labels}
+    rows = [[scene, *(f"{flight[label][scene]:.1f} / {reversals[label][scene]:.1f}" for label in labels)]
+            for scene in budget]
+    rows.append(["**mean**", *(f"**{np.mean(list(flight[label].values())):.1f} / "
+                               f"{np.mean(list(reversals[label].values())):.1f}**" for label in labels)])
     return markdown_table(["building", *labels], rows)
 
 

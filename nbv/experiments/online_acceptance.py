@@ -45,10 +45,14 @@ Runs = Mapping[str, Mapping[str, Sequence[dict]]]
 """Runs per building, then per planner label: each a `nbv compare` run record (gt, flight_m, viewpoints)."""
 
 
+def per_building(runs: Runs, label: str, value: Callable[[dict], float]) -> dict[str, float]:
+    """Per building, the mean over seeds of `value` of the planner's run records."""
+    return {scene: float(np.mean([value(r) for r in by[label]])) for scene, by in runs.items()}
+
+
 def mean_coverage(runs: Runs, label: str) -> dict[str, float]:
     """Per building, the planner's mean coverage of the true surface over seeds, percent."""
-    return {scene: 100.0 * float(np.mean([r["gt"]["coverage"] for r in by[label]]))
-            for scene, by in runs.items()}
+    return per_building(runs, label, lambda r: 100.0 * r["gt"]["coverage"])
 
 
 def mean_flight(runs: Runs, label: str) -> float:

@@ -1,16 +1,19 @@
 """Named starting points of `nbv train` (`--preset NAME`); every flag still overrides them.
 
-- `default`: what `scripts/select_defaults.py` chose on validation buildings (issue 11,
-  paper_results/selection): the paper's networks and SAC on a view lattice at 160x120,
-  4 spp, OpenCV SIFT, with relative actions (steps up to 1/8 of each range), rewards
-  scaled by 0.1, Bag of Views ranges split into 2 elevation bands, a coverage term added to
-  the reward (`COVERAGE_REWARD`), episodes of 13 views
-  (the evaluation's budget) instead of one pass, 6000 frames, every 250 frames the actor
-  scored on the validation buildings, trained on `TRAIN_SCENES`; 3 members (training seeds,
-  3 local workers) and the best-validated actor of them all kept as `policy.pt`.
-- `looks`: a candidate, not chosen yet (issue 26, paper_results/selection/round5): the default with the
-  Bag of Views observation (`EnvConfig.bov_observation`) and the family buildings: `FAMILY_TRAIN_SCENES`
-  added to the training buildings and `FAMILY_VALIDATION_SCENES` to the validation buildings.
+- `default`: what issue 26's selection rounds chose on validation buildings (paper_results/selection,
+  rounds 5 to 11): `looks` with the look map (`EnvConfig.look_map`), orbit actions (an azimuth step of up
+  to 60 degrees, absolute radius and elevation), a flight-cost term (`FLIGHT_REWARD`) and an imitation
+  term pulling the actor towards the privileged teacher (`IMITATION`), trained on `DEFAULT_TRAIN_SCENES`;
+  `MEMBERS` training seeds, the best-validated actor of them all kept as `policy.pt`.
+- `coverage`: the default until issue 26 (issue 11, paper_results/selection rounds 1 to 4): the paper's
+  networks and SAC on a view lattice at 160x120, 4 spp, OpenCV SIFT, with relative actions (steps up to
+  1/8 of each range), rewards scaled by 0.1, Bag of Views ranges split into 2 elevation bands, a coverage
+  term added to the reward (`COVERAGE_REWARD`), episodes of 13 views (the evaluation's budget) instead
+  of one pass, 6000 frames, every 250 frames the actor scored on the validation buildings, trained on
+  `TRAIN_SCENES`; 3 members (training seeds, 3 local workers).
+- `looks`: `coverage` with the Bag of Views observation (`EnvConfig.bov_observation`) and the family
+  buildings: `FAMILY_TRAIN_SCENES` added to the training buildings and `FAMILY_VALIDATION_SCENES` to the
+  validation buildings (paper_results/selection/round5).
 - `paper`: the paper's Table 1 to the letter (absolute actions, fixed alpha 0.2, raw
   rewards, azimuth-only Bag of Views ranges, the Bag of Views reward alone, every view
   rendered): the config classes' own defaults.
@@ -45,7 +48,7 @@ TRAIN_SCENES = ("medieval_tavern", "forest_ruin_house", "random:1", "random:2", 
 """The generalist's training buildings: both training presets and four training-split random buildings
 (held out: alpine_chalet, imperial_temple and random:SEED with SEED % 5 == 0)."""
 FRAMES = 6000
-"""The default preset's budget (round 2 of paper_results/selection compared candidates at it)."""
+"""Every lattice preset's budget (round 2 of paper_results/selection compared candidates at it)."""
 VALIDATION_SCENES = ("random:6", "random:7", "random:8")
 """Training-split buildings no run trains on: candidates and checkpoints are chosen on these."""
 COVERAGE_REWARD = 100.0
@@ -57,8 +60,21 @@ FAMILY_TRAIN_SCENES = ("family:1", "family:2", "family:7", "family:8")
 the view lattices' cost on 2 cores: the ones whose best orbit differs most (paper_results/family)."""
 FAMILY_VALIDATION_SCENES = ("family:4",)
 """A validation-split `family:SEED` building (SEED % 5 == 4), a tower: one, for the lattice's cost."""
-MEMBERS = 3
-"""Training seeds of one default command, side by side (three 6000-frame runs took 11-15 min on 2 cores)."""
+COVERAGE_MEMBERS = 3
+"""Training seeds of one `coverage` command, side by side (three 6000-frame runs: 11-15 min on 2 cores)."""
+DEFAULT_TRAIN_SCENES = (*TRAIN_SCENES, *FAMILY_TRAIN_SCENES, "family:3", "family:11", "family:12",
+                        "family:18")
+"""The default's 14 training buildings (round 8 of paper_results/selection): `looks`' ten and one more
+training-split family building of each seen trait."""
+ORBIT_STEP = 0.16666667
+"""The default's largest azimuth step, as a share of the range: 60 degrees (round 9: steps of 1/8 cannot fly
+the teacher's path). Written to 8 decimals, as the selection rounds' command lines gave it."""
+FLIGHT_REWARD = 0.2
+"""The default's weight of the flight-cost term, per metre (round 9: the teacher's best on validation)."""
+IMITATION = 1000.0
+"""The default's weight of the imitation term (rounds 8, 10 and 11)."""
+MEMBERS = 2
+"""Training seeds of one default command, side by side (two 6000-frame runs took about 40 min on 2 cores)."""
 
 
 def paper_preset() -> TrainConfig:
@@ -67,8 +83,8 @@ def paper_preset() -> TrainConfig:
     return TrainConfig(env=EnvConfig(scenes=scenes), logger=LoggerConfig(out=tyro.MISSING))
 
 
-def default_preset() -> TrainConfig:
-    """The toolkit's default: chosen on validation buildings (paper_results/selection)."""
+def coverage_preset() -> TrainConfig:
+    """The default until issue 26: chosen on validation buildings (paper_results/selection rounds 1 to 4)."""
     paper = paper_preset()
     env = replace(paper.env, camera=UAVCamera(160, 120), render=RenderSettings(spp=4),
                   bov=replace(paper.env.bov, elevation_bands=2, sift=FeatureConfig(backend="opencv")),
@@ -78,17 +94,30 @@ def default_preset() -> TrainConfig:
                    collector=CollectorConfig(frames=FRAMES), optim=OptimConfig(reward_scale=0.1),
                    logger=replace(paper.logger, checkpoint_every=250),
                    validation=ValidationConfig(validation_scenes=VALIDATION_SCENES),
-                   members=MembersConfig(count=MEMBERS), executor=ExecutorConfig(workers=MEMBERS))
+                   members=MembersConfig(count=COVERAGE_MEMBERS),
+                   executor=ExecutorConfig(workers=COVERAGE_MEMBERS))
 
 
 def looks_preset() -> TrainConfig:
-    """The default with the Bag of Views observation, trained on the family buildings too."""
-    default = default_preset()
+    """`coverage` with the Bag of Views observation, trained on the family buildings too."""
+    coverage = coverage_preset()
     scenes = SceneSet(scene=TRAIN_SCENES + FAMILY_TRAIN_SCENES)
-    env = replace(default.env, scenes=scenes, bov_observation=True)
-    validation = replace(default.validation, validation_scenes=VALIDATION_SCENES + FAMILY_VALIDATION_SCENES)
-    return replace(default, env=env, validation=validation)
+    env = replace(coverage.env, scenes=scenes, bov_observation=True)
+    validation = replace(coverage.validation, validation_scenes=VALIDATION_SCENES + FAMILY_VALIDATION_SCENES)
+    return replace(coverage, env=env, validation=validation)
 
 
-PRESETS = {"default": default_preset, "paper": paper_preset, "looks": looks_preset}
+def default_preset() -> TrainConfig:
+    """The toolkit's default: `looks` with the look map, orbit actions, the flight and imitation terms
+    (chosen on validation buildings, paper_results/selection)."""
+    looks = looks_preset()
+    env = replace(looks.env, scenes=SceneSet(scene=DEFAULT_TRAIN_SCENES), look_map=True, action_mode="orbit",
+                  relative_step=ORBIT_STEP)
+    reward = replace(looks.reward, flight=FLIGHT_REWARD, imitation=IMITATION)
+    return replace(looks, env=env, reward=reward, logger=replace(looks.logger, checkpoint_every=500),
+                   members=MembersConfig(count=MEMBERS), executor=ExecutorConfig(workers=MEMBERS))
+
+
+PRESETS = {"default": default_preset, "paper": paper_preset, "coverage": coverage_preset,
+           "looks": looks_preset}
 """`nbv train --preset NAME`."""

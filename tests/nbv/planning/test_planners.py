@@ -182,18 +182,23 @@ def test_bare_policy_spec_is_the_shipped_policy():
     assert made.keys() == shipped.keys() and all(torch.equal(made[k], shipped[k]) for k in made)
 
 
-def test_shipped_policy_is_the_default_training_command_and_plans():
+@pytest.mark.parametrize("path, command", [
+    (SHIPPED_POLICY, ["--out", "runs/default"]),  # nbv/planning/shipped/README.md
+    (SHIPPED_POLICY.parent / "coverage" / "policy.pt", ["--preset", "coverage", "--out", "runs/default"]),
+])
+def test_shipped_policy_is_its_training_command_and_plans(path, command):
     from common.provenance import config_record
     from nbv.cli.train import parse_train
+    from nbv.rl.checkpoint import load_policy
     from nbv.rl.train import with_defaults
 
-    raw = torch.load(SHIPPED_POLICY, weights_only=True)  # no pickled code in the shipped file
-    assert raw["format"] == "nbv-sac-policy" and SHIPPED_POLICY.stat().st_size < 5_000_000
-    shipped = with_defaults(json.loads(raw["config"]))  # settings added since then at their defaults
-    default = config_record(parse_train(["--out", "runs/default"]))
-    for group in ("env", "collector", "replay_buffer", "optim", "network", "validation"):
-        assert shipped[group] == default[group], group  # `nbv train --out runs/default` retrains it
-    planner = make_planner("policy", PLAN)
+    raw = torch.load(path, weights_only=True)  # no pickled code in the shipped file
+    assert raw["format"] == "nbv-sac-policy" and path.stat().st_size < 5_000_000
+    shipped = with_defaults(load_policy(path)[0])  # older layouts read, settings added since at defaults
+    default = config_record(parse_train(command))
+    for group in ("env", "reward", "collector", "replay_buffer", "optim", "network", "validation", "members"):
+        assert shipped[group] == default[group], group  # the README's command retrains it
+    planner = make_planner(f"policy:{path}", PLAN)
     assert isinstance(planner, PolicyPlanner) and planner.env_config.bov.elevation_bands == 2
     world = PlanningWorld(replace(planner.env_config, scenes=TEST_BUILDING, lattice=LatticeConfig()))
     views = planner.plan(world, 3)

@@ -139,6 +139,7 @@ def test_policy_without_checksum_loads_with_a_warning(tmp_path):
 
 
 @pytest.mark.parametrize("path", ["nbv/planning/shipped/policy.pt", "nbv/planning/shipped/paper/policy.pt",
+                                  "nbv/planning/shipped/coverage/policy.pt",
                                   "paper_results/online/policies/seed1/policy.pt",
                                   "paper_results/online/policies/seed2/policy.pt"])
 def test_shipped_policies_carry_their_checksum(path):

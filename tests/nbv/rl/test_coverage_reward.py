@@ -145,7 +145,7 @@ def test_the_validator_scores_on_the_true_mesh_but_its_envs_have_no_term(tmp_pat
 def test_the_run_config_holds_the_term_in_its_reward_group_not_in_the_env():
     from nbv.cli.train import parse_train
 
-    record = config_record(parse_train(["--coverage-reward", "30", "--out", "run"]))
+    record = config_record(parse_train(["--preset", "coverage", "--coverage-reward", "30", "--out", "run"]))
     assert record["reward"] == {"coverage": 30.0, "flight": 0.0, "imitation": 0.0, "teacher_horizon": 3,
                                 "teacher_discount": 0.9}
     assert "coverage_reward" not in record["env"]
@@ -166,6 +166,7 @@ def test_the_command_line_sets_the_weight():
 
     assert parse_train(["--coverage-reward", "300", "--out", "run"]).reward.coverage == 300.0
     assert parse_train(["--out", "run"]).reward.coverage == COVERAGE_REWARD == 100.0
+    assert parse_train(["--preset", "coverage", "--out", "run"]).reward.coverage == COVERAGE_REWARD
     assert parse_train(["--preset", "paper", "--out", "run"]).reward.coverage == 0.0
     assert parse_train(["--coverage-reward", "0", "--out", "run"]).reward.coverage == 0.0
 

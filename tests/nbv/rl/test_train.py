@@ -240,16 +240,15 @@ def test_a_record_from_before_the_reward_group_reads_into_it():
 
 
 def test_shipped_records_read_into_the_reward_and_members_groups():
-    from pathlib import Path
-
     from nbv.planning.registry import SHIPPED_POLICY
 
-    config, _ = load_policy(SHIPPED_POLICY)
-    raw = json.loads(torch.load(SHIPPED_POLICY, weights_only=True)["config"])
+    old = SHIPPED_POLICY.parent / "coverage" / "policy.pt"  # the default shipped until issue 26
+    config, _ = load_policy(old)
+    raw = json.loads(torch.load(old, weights_only=True)["config"])
     assert raw["env"]["coverage_reward"] == 100.0 and raw["validation"]["members"] == 3  # the old layout
     assert config["reward"] == {"coverage": 100.0} and config["members"] == {"count": 3}
     assert "coverage_reward" not in config["env"] and "members" not in config["validation"]
-    recorded = json.loads((Path(SHIPPED_POLICY).parent / "config.json").read_text())
+    recorded = json.loads((old.parent / "config.json").read_text())
     assert with_defaults(recorded)["reward"] == {"coverage": 100.0, "flight": 0.0, "imitation": 0.0,
                                                  "teacher_horizon": 3, "teacher_discount": 0.9}
     parsed = config_from_record(TrainConfig, config)

@@ -313,6 +313,8 @@ INDEX = (
            "without frames", LOOKS_EVAL),
     Result("selection/round10/README.md", "selection/round10/results.json", "its tenth round: a student of "
            "the teacher with orbit actions", LOOKS_EVAL),
+    Result("selection/round11/README.md", "selection/round11/results.json", "its eleventh round: the "
+           "imitation weight, a second seed; the re-ship", LOOKS_EVAL),
     Result("selection/round1/selection.md", "selection/round1/selection.json", "its first round, before the "
            "lattice fix", "scripts/select_defaults.py --round 1"),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "

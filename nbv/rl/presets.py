@@ -52,7 +52,7 @@ FRAMES = 6000
 VALIDATION_SCENES = ("random:6", "random:7", "random:8")
 """Training-split buildings no run trains on: candidates and checkpoints are chosen on these."""
 COVERAGE_REWARD = 100.0
-"""The default's weight of the reward's coverage term (round 4 of paper_results/selection: 100 and 300
+"""The lattice presets' weight of the reward's coverage term (round 4 of paper_results/selection: 100 and 300
 against none, then 100 over nine seeds)."""
 FAMILY_TRAIN_SCENES = ("family:1", "family:2", "family:7", "family:8")
 """Training-split `family:SEED` buildings of four seen traits: a tower, a courtyard, an arcade and a hall
@@ -64,8 +64,8 @@ COVERAGE_MEMBERS = 3
 """Training seeds of one `coverage` command, side by side (three 6000-frame runs: 11-15 min on 2 cores)."""
 DEFAULT_TRAIN_SCENES = (*TRAIN_SCENES, *FAMILY_TRAIN_SCENES, "family:3", "family:11", "family:12",
                         "family:18")
-"""The default's 14 training buildings (round 8 of paper_results/selection): `looks`' ten and one more
-training-split family building of each seen trait."""
+"""The default's 14 training buildings (round 8 of paper_results/selection): `looks`' ten, a U plan
+(`family:3`) and a second tower, courtyard and hall (`family:11`, `12`, `18`)."""
 ORBIT_STEP = 0.16666667
 """The default's largest azimuth step, as a share of the range: 60 degrees (round 9: steps of 1/8 cannot fly
 the teacher's path). Written to 8 decimals, as the selection rounds' command lines gave it."""
@@ -74,7 +74,7 @@ FLIGHT_REWARD = 0.2
 IMITATION = 1000.0
 """The default's weight of the imitation term (rounds 8, 10 and 11)."""
 MEMBERS = 2
-"""Training seeds of one default command, side by side (two 6000-frame runs took about 40 min on 2 cores)."""
+"""Training seeds of one default command, side by side (two 6000-frame runs: 32 min on 2 cores)."""
 
 
 def paper_preset() -> TrainConfig:

@@ -38,6 +38,7 @@ from nbv.experiments.compare import CompareConfig, compare_planners
 from nbv.experiments.online_acceptance import (
     acceptance_checks,
     acceptance_section,
+    building_mean,
     mean_coverage,
     per_building,
 )
@@ -169,7 +170,7 @@ def online_report(budget: dict[str, dict[str, list[dict]]], one_pass: dict[str, 
     labels = list(next(iter(budget.values())))
     coverage = {label: mean_coverage(budget, label) for label in labels}
     rows = [[scene, *(f"{coverage[label][scene]:.1f}" for label in labels)] for scene in budget]
-    overall = {label: float(np.mean(list(by.values()))) for label, by in coverage.items()}
+    overall = {label: building_mean(by) for label, by in coverage.items()}
     rows.append(["**mean**", *(f"**{overall[label]:.1f}**" for label in labels)])
     planning = {label: float(np.mean([r["planning_s"] for runs in budget.values() for r in runs[label]]))
                 for label in labels}
@@ -221,8 +222,8 @@ def _flight_table(budget: dict[str, dict[str, list[dict]]], labels: list[str]) -
     reversals = {label: per_building(budget, label, lambda r: r["azimuth_reversals"]) for label in labels}
     rows = [[scene, *(f"{flight[label][scene]:.1f} / {reversals[label][scene]:.1f}" for label in labels)]
             for scene in budget]
-    rows.append(["**mean**", *(f"**{np.mean(list(flight[label].values())):.1f} / "
-                               f"{np.mean(list(reversals[label].values())):.1f}**" for label in labels)])
+    rows.append(["**mean**", *(f"**{building_mean(flight[label]):.1f} / "
+                               f"{building_mean(reversals[label]):.1f}**" for label in labels)])
     return markdown_table(["building", *labels], rows)
 
 

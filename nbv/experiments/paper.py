@@ -283,8 +283,8 @@ INDEX = (
            "(ours, the paper preset's)", "make tables"),
     Result("budget/budget.md", "budget/budget.json", "coverage against view budget and metres flown, AUC",
            "make tables"),
-    Result("online/online.md", "online/online.json", "the previous default's policy (`coverage/`) and the "
-           "paper preset's against the baselines, 13 views, five held-out buildings, one pass",
+    Result("online/online.md", "online/online.json", "the shipped policy and the paper "
+           "preset's against the baselines, 13 views, five held-out buildings, one pass",
            "nbv online (command in the file)"),
     Result("online/acceptance/online.md", "online/acceptance/online.json", "issue 26's acceptance, check by "
            "check: the shipped policies against random views and the tuned orbits, with blank images, on "

@@ -318,6 +318,8 @@ INDEX = (
            "imitation weight, a second seed; the re-ship", LOOKS_EVAL),
     Result("selection/round12/README.md", "selection/round12/results.json", "its twelfth round: a heavier "
            "flight term, a third training courtyard", LOOKS_EVAL),
+    Result("selection/round13/README.md", "selection/round13/results.json", "its thirteenth round: round "
+           "12's two changes together, two seeds", LOOKS_EVAL),
     Result("selection/round1/selection.md", "selection/round1/selection.json", "its first round, before the "
            "lattice fix", "scripts/select_defaults.py --round 1"),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "

@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import re
 import subprocess
 import types
 import typing
@@ -111,6 +112,43 @@ def recorded_config(cls: type[T], path: str | Path, command: str) -> T:
         return config_from_record(cls, record["config"])
     except TypeError as err:
         raise ValueError(f"--config {path}: {err}") from err
+
+
+ELSEWHERE = "ELSEWHERE"
+"""What stands, in a committed record, for the folders above a path outside the working directory."""
+_ABSOLUTE = re.compile(r"(?<![\w./])/(?!/)[^\s:=,'\"]+")
+
+
+def portable_path(path: str | Path, root: Path | None = None) -> str:
+    """`path` as a committed record may hold it: relative to `root` (default: the working directory) when
+    under it, else its last two parts under `ELSEWHERE` (no machine's folders in a record).
+
+    Example:
+        >>> portable_path("/home/ann/runs/r1/policy.pt", Path("/srv/nbv"))
+        'ELSEWHERE/r1/policy.pt'
+    """
+    root = (root or Path.cwd()).resolve()
+    absolute = Path(path).resolve()
+    if absolute.is_relative_to(root):
+        return absolute.relative_to(root).as_posix() or "."
+    return "/".join((ELSEWHERE, *absolute.parts[1:][-2:]))
+
+
+def portable_text(text: str, root: Path | None = None) -> str:
+    """`text` (a command line, an argument such as `NAME=PATH` or `policy:PATH`) with every absolute path
+    in it made portable (`portable_path`); relative paths and URLs are left as they are."""
+    return _ABSOLUTE.sub(lambda match: portable_path(match.group(), root), text)
+
+
+def portable_record(record: Any, root: Path | None = None) -> Any:
+    """A JSON-compatible record with `portable_text` applied to every string in it."""
+    if isinstance(record, str):
+        return portable_text(record, root)
+    if isinstance(record, dict):
+        return {key: portable_record(value, root) for key, value in record.items()}
+    if isinstance(record, list):
+        return [portable_record(value, root) for value in record]
+    return record
 
 
 RESULTS = "paper_results"

@@ -29,7 +29,7 @@ import numpy as np
 from tqdm import tqdm
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
-from common.provenance import git_commit
+from common.provenance import git_commit, portable_record
 from nbv.features.source import ViewSource
 from nbv.flight.record import flight_record
 from nbv.flight.spread import pair_spreads_m
@@ -192,9 +192,9 @@ def main() -> None:
         plot_seed_scores({n: list(d["summary"]["coverage"].values()) for n, d in results.items()},
                          out / "coverage.png", "visible coverage % (validation buildings)",
                          "13 views: policies vs the tuned orbit")
-        write_json(out / "results.json", {
+        write_json(out / "results.json", portable_record({
             "commit": git_commit(), "scenes": args.scenes, "seeds": args.seeds, "views": args.views,
-            "policies": dict(p.split("=", 1) for p in args.policy), "results": results, "command": sys.argv})
+            "policies": dict(p.split("=", 1) for p in args.policy), "results": results, "command": sys.argv}))
     print(table)
 
 

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from common.io import atomic_folder, write_json, write_text
-from common.provenance import git_commit
+from common.provenance import git_commit, portable_record
 from nbv.planning.base import Planner
 from nbv.planning.config import PlanSettings
 from nbv.planning.registry import make_planner
@@ -91,8 +91,9 @@ def main() -> None:
         plot_seed_scores({n: list(d["summary"]["coverage"].values()) for n, d in results.items()},
                          out / "coverage.png", "visible coverage % (validation buildings)",
                          f"{args.views} views: the teacher vs the tuned orbit")
-        write_json(out / "results.json", {"commit": git_commit(), "scenes": args.scenes, "seeds": args.seeds,
-                                          "views": args.views, "results": results, "command": sys.argv})
+        write_json(out / "results.json", portable_record({
+            "commit": git_commit(), "scenes": args.scenes, "seeds": args.seeds, "views": args.views,
+            "results": results, "command": sys.argv}))
     print(table)
     print("mean coverage:", {n: round(float(np.mean(list(d["summary"]["coverage"].values()))), 1)
                              for n, d in results.items()})

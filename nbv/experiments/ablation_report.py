@@ -17,7 +17,7 @@ import numpy as np
 from PIL import Image
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
-from common.provenance import config_record, git_commit
+from common.provenance import config_record, git_commit, portable_record
 from nbv.bov.sweep import write_csv
 from nbv.experiments.ablation_axes import AXES, REFERENCE, Level, Unit, unit_path
 from nbv.viz.ablation import plot_axis, plot_crops, plot_quality_vs_time
@@ -160,9 +160,10 @@ def _crop_images(docs: list[dict[str, Any]], folder: Path,
 def write_report(config: AblateConfig, docs: list[dict[str, Any]], folder: Path, seconds: float) -> None:
     """Write every output of the run onto `config.out` together."""
     rows = summary_rows(docs, config.axes)
-    header = {"command": rerun_command(config).replace("DIR", str(config.out)), "commit": git_commit(),
-              "seconds": round(seconds, 1), "units": len(docs), "scan_views": docs[0]["scan_views"],
-              "config": config_record(config, omit=("executor",))}
+    header = portable_record({
+        "command": rerun_command(config).replace("DIR", str(config.out)), "commit": git_commit(),
+        "seconds": round(seconds, 1), "units": len(docs), "scan_views": docs[0]["scan_views"],
+        "config": config_record(config, omit=("executor",))})
     outputs = OUTPUTS + tuple(f"axis_{name}.png" for name in AXES)
     with atomic_folder(config.out, overwrite=True, outputs=outputs) as out:
         write_csv(out / "ablations.csv", rows, fieldnames=list(rows[0]))

@@ -33,7 +33,7 @@ import numpy as np
 from tyro.conf import arg
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
-from common.provenance import config_record, git_commit
+from common.provenance import config_record, git_commit, portable_record, portable_text
 from nbv.experiments.compare import CompareConfig, compare_planners
 from nbv.experiments.online_acceptance import (
     acceptance_checks,
@@ -131,12 +131,12 @@ def run_online(config: OnlineConfig) -> str:
         found[comparison.scene.scene] = _runs(comparison.out)
     policy = planner_label(config.policies[0])
     checks = acceptance_checks(budget, blank or None, [planner_label(spec) for spec in config.policies])
-    text = online_report(budget, one_pass, policy, config, checks)
-    coverage = {label: list(mean_coverage(budget, label).values()) for label in next(iter(budget.values()))}
-    record = config_record(config, omit=("executor",))
+    coverage = {label: mean_coverage(budget, label) for label in next(iter(budget.values()))}
+    text = online_report(budget, coverage, one_pass, policy, config, checks)
+    record = portable_record(config_record(config, omit=("executor",)))
     with atomic_folder(out, overwrite=True, outputs=OUTPUTS) as folder:
         write_text(folder / "online.md", text)
-        plot_seed_scores(coverage, folder / "online.png",
+        plot_seed_scores({label: list(by.values()) for label, by in coverage.items()}, folder / "online.png",
                          f"coverage % of the true surface, {config.views} views",
                          f"mean over {len(config.seeds)} seeds; one dot per building")
         write_json(folder / "online.json", {"commit": git_commit(), "config": record, "budget": budget,
@@ -145,10 +145,12 @@ def run_online(config: OnlineConfig) -> str:
 
 
 def rerun_command(config: OnlineConfig) -> str:
-    """The `nbv online` command line that re-runs `config`'s evaluation (its output folder left as DIR)."""
-    return (f"nbv online --scenes {' '.join(config.scenes)} --policies {' '.join(config.policies)} "
-            f"--baselines {' '.join(config.baselines)} --seeds {' '.join(map(str, config.seeds))} "
-            f"--views {config.views}{'' if config.blank else ' --no-blank'} --out DIR")
+    """The `nbv online` command line that re-runs `config`'s evaluation (its output folder left as DIR, paths
+    portable: `portable_text`)."""
+    return portable_text(
+        f"nbv online --scenes {' '.join(config.scenes)} --policies {' '.join(config.policies)} "
+        f"--baselines {' '.join(config.baselines)} --seeds {' '.join(map(str, config.seeds))} "
+        f"--views {config.views}{'' if config.blank else ' --no-blank'} --out DIR")
 
 
 def _runs(folder: Path) -> dict[str, list[dict]]:
@@ -163,12 +165,12 @@ def _values(runs: list[dict], against: str, key: str) -> list[float]:
     return [r[against][key] for r in runs]
 
 
-def online_report(budget: dict[str, dict[str, list[dict]]], one_pass: dict[str, dict[str, list[dict]]],
-                  policy: str, config: OnlineConfig, checks: dict[str, list[dict]]) -> str:
-    """The Markdown report: 13-view coverage per building with the policy's margins, then one pass, then
-    the acceptance checks (`checks`, by policy)."""
-    labels = list(next(iter(budget.values())))
-    coverage = {label: mean_coverage(budget, label) for label in labels}
+def online_report(budget: dict[str, dict[str, list[dict]]], coverage: dict[str, dict[str, float]],
+                  one_pass: dict[str, dict[str, list[dict]]], policy: str, config: OnlineConfig,
+                  checks: dict[str, list[dict]]) -> str:
+    """The Markdown report: 13-view coverage per building (`coverage`, by planner label, `mean_coverage`)
+    with the policy's margins, then one pass, then the acceptance checks (`checks`, by policy)."""
+    labels = list(coverage)
     rows = [[scene, *(f"{coverage[label][scene]:.1f}" for label in labels)] for scene in budget]
     overall = {label: building_mean(by) for label, by in coverage.items()}
     rows.append(["**mean**", *(f"**{overall[label]:.1f}**" for label in labels)])

@@ -52,8 +52,8 @@ def test_online_report_from_saved_runs(tmp_path):
     assert "- policy-shipped minus random: +15.0 points" in text
     assert "- policy-shipped minus greedy: +0.0 points" in text
     assert ("Re-run: `nbv online --scenes alpine_chalet random:5 --policies policy "
-            f"policy:{tmp_path}/seed1/policy.pt --baselines random circle greedy --seeds 0 1 --views 13 "
-            "--out DIR`") in text
+            "policy:ELSEWHERE/seed1/policy.pt --baselines random circle greedy --seeds 0 1 --views 13 "
+            "--out DIR`") in text  # no machine's folders in a committed report
     assert "- planning speed-up over greedy (without the simulated camera): 100x" in text
     spread = ("- spread over the 2 policies: 10.0 points "
               "(policy-shipped 85.0, policy-seed1 75.0)")
@@ -74,6 +74,8 @@ def test_online_report_from_saved_runs(tmp_path):
     assert (tmp_path / "online.md").read_text() == text
     saved = json.loads((tmp_path / "online.json").read_text())
     assert saved["config"]["seeds"] == [0, 1] and len(saved["budget"]["random:5"]["greedy"]) == 2
+    assert str(tmp_path) not in json.dumps(saved)
+    assert saved["config"]["out"] == f"ELSEWHERE/{tmp_path.parent.name}/{tmp_path.name}"
     assert len(saved["blank"]["random:5"]["policy-seed1"]) == 2 and set(saved["acceptance"]) == {
         "policy-shipped", "policy-seed1"}
     assert Image.open(tmp_path / "online.png").size[0] > 300

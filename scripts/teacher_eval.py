@@ -65,7 +65,7 @@ def main() -> None:
     parser.add_argument("--flight-reward", type=float, nargs="+", default=[0.5])
     parser.add_argument("--teacher-horizon", type=int, default=3, help="0: to the end of the budget")
     parser.add_argument("--teacher-discount", type=float, default=0.9)
-    parser.add_argument("--action-mode", choices=("relative", "orbit"), default=None,
+    parser.add_argument("--action-mode", choices=("relative", "orbit", "forward"), default=None,
                         help="the teacher's action space (default: the looks preset's)")
     parser.add_argument("--relative-step", type=float, default=None,
                         help="its largest step per view, a fraction of each range (default: the preset's)")

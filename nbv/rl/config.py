@@ -88,12 +88,13 @@ class EnvConfig:
     """0: an episode ends after one pass around the target (the paper) or at the step cap. N > 0: it ends
     after N views, the start view included, wherever the camera is (a fixed view budget, beyond the
     paper: training then matches a 13-view evaluation instead of stopping after one pass)."""
-    action_mode: Literal["absolute", "relative", "orbit"] = "absolute"
-    """Action meaning: the next viewpoint (paper), a step from the current one, or an azimuth step with
-    absolute R and elevation (orbit)."""
+    action_mode: Literal["absolute", "relative", "orbit", "forward"] = "absolute"
+    """Action meaning: the next viewpoint (paper), a step from the current one, an azimuth step with
+    absolute R and elevation (orbit), or an azimuth advance of half to all of `relative_step` of a turn
+    with absolute R and elevation (forward: never hovering or turning back)."""
     relative_step: float = 0.25
-    """Relative and orbit modes: the largest step per action, as a fraction of each range (azimuth: of
-    2 pi)."""
+    """Relative, orbit and forward modes: the largest step per action, as a fraction of each range
+    (azimuth: of 2 pi)."""
     bov_observation: bool = False
     """Beyond the paper: add to the state a vector of what the Bag of Views has seen (key `bov`,
     `nbv.rl.bov_observation`): each vocabulary's word and descriptor fill, the last view's novelty, the

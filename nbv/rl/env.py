@@ -11,7 +11,10 @@ next viewpoint itself, rescaled to the allowed ranges of R, azimuth and
 elevation ("rescaled to conform to the specified ranges", Sec. IV); in the
 `relative` mode they are a step from the current viewpoint, at most
 `relative_step` of each range, clipped to the ranges; in the `orbit` mode
-the azimuth is such a step and R and elevation are absolute. Orbit exists
+the azimuth is such a step and R and elevation are absolute; in the `forward`
+mode (beyond the paper) R and elevation are absolute and the azimuth always
+advances, by half to all of `relative_step` of a turn, as a pilot's orbit
+does (no hovering, no turning back). Orbit exists
 because absolute azimuth is a circular target that a tanh output cannot
 follow across 0 = 2 pi (moving on by 45 degrees from 350 needs an action
 jump from +1 to -1), and it keeps R and elevation free of the drift of
@@ -114,6 +117,9 @@ def action_to_viewpoint(action: Any, current: Viewpoint, config: EnvConfig) -> V
         r, az, el = absolute
     elif config.action_mode == "orbit":
         r, az, el = absolute[0], step[1], absolute[2]
+    elif config.action_mode == "forward":
+        advance = (a[1] + 3.0) / 4.0 * config.relative_step * TWO_PI
+        r, az, el = absolute[0], current.azimuth + advance, absolute[2]
     else:
         r, az, el = step
         r, el = np.clip(r, low[0], high[0]), np.clip(el, low[2], high[2])

@@ -176,6 +176,18 @@ def test_orbit_steps_the_azimuth_and_sets_radius_and_elevation():
     assert back.elevation == pytest.approx(math.radians(5))
 
 
+def test_forward_always_advances_the_azimuth_and_sets_radius_and_elevation():
+    forward = replace(tiny_config(), action_mode="forward", relative_step=2 / 13)
+    least = action_to_viewpoint([-1.0, -1.0, -1.0], Viewpoint(2.0, 6.2, 0.3), forward)
+    assert least.azimuth == pytest.approx(6.2 + 2 * math.pi / 13 - 2 * math.pi)  # half: one turn in 13 views
+    assert least.radius == pytest.approx(1.5) and least.elevation == pytest.approx(math.radians(5))
+    most = action_to_viewpoint([1.0, 1.0, 1.0], Viewpoint(2.0, 0.1, 0.3), forward)
+    assert most.azimuth == pytest.approx(0.1 + 4 * math.pi / 13)  # the whole step: two turns in 13 views
+    assert most.radius == pytest.approx(2.5) and most.elevation == pytest.approx(math.radians(80))
+    middle = action_to_viewpoint([0.0, 0.0, 0.0], Viewpoint(2.0, 0.1, 0.3), forward)
+    assert middle.azimuth == pytest.approx(0.1 + 3 * math.pi / 13)
+
+
 def test_match_cosine_reaches_the_reward():
     """Same seed, same actions: only the Bag of Views' c differs, and so do the rewards."""
     rewards = {}

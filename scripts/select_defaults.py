@@ -11,8 +11,8 @@ model-selection score). This script keeps the rounds' candidates and runs them.
     python scripts/select_defaults.py train --round 2 --runs runs/selection --frames 6000 --jobs 3
     python scripts/select_defaults.py score --runs runs/selection --out paper_results/selection
 
-(round 1, before the lattice fix: `train --round 1 --frames 4000`, scored into
-paper_results/selection/round1.)
+(round 1, before the lattice fix: `train --round 1 --frames 4000`; its results, measured on a tree with
+uncommitted changes, left paper_results and stay in the git history at f32fc04.)
 """
 
 from __future__ import annotations

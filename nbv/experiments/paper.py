@@ -322,8 +322,6 @@ INDEX = (
            "12's two changes together, two seeds", LOOKS_EVAL),
     Result("selection/round14/README.md", "selection/round14/results.json", "its fourteenth round: the "
            "default command's members trained on to 9000 frames", LOOKS_EVAL),
-    Result("selection/round1/selection.md", "selection/round1/selection.json", "its first round, before the "
-           "lattice fix", "scripts/select_defaults.py --round 1"),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

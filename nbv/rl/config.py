@@ -284,6 +284,10 @@ class ValidationConfig:
     """Views per validation episode, the start view included."""
     validation_points: int = 20_000
     """True-surface samples of the coverage score per building."""
+    validation_keep: bool = False
+    """Also write every validated actor to `validated/policy_FRAMES.pt` in the run folder, so a checkpoint
+    can be chosen afterwards by other checks than the lattice score (exact renders, metres, blank images:
+    `scripts/looks_eval.py`)."""
 
     def __post_init__(self) -> None:
         for name in ("validation_episodes", "validation_views", "validation_points"):

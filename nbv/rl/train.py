@@ -83,6 +83,8 @@ TRAINING_PNG = "training.png"
 POLICY = "policy.pt"
 """The actor and config alone (a few MB, for planning), written beside every checkpoint; with validation
 buildings, only when the checkpoint's actor scores best on them so far."""
+VALIDATED = "validated"
+"""The run's folder of every validated actor's policy file (`ValidationConfig.validation_keep`)."""
 VALIDATION_CSV = "validation.csv"
 """One row per validated checkpoint: frames, the score (%) per validation building, their mean, the best."""
 RESUMABLE_CHANGES = ("collector.frames", "collector.threads", "logger.out", "logger.checkpoint_every",
@@ -330,6 +332,11 @@ def sac_update(loss_module: SACLoss, optim_actor: torch.optim.Optimizer, optim_c
             "entropy": losses["entropy"].item(), "alpha": losses["alpha"].item(), **imitated}
 
 
+def validated_policy(run: Path, frames: int) -> Path:
+    """The policy file of the actor validated at `frames` (`ValidationConfig.validation_keep`)."""
+    return run / VALIDATED / f"policy_{frames:06d}.pt"
+
+
 def validate_checkpoint(validator: LatticeValidator, run: Path, config: TrainConfig, loss_state: dict,
                         counters: dict[str, int], best: dict | None) -> dict:
     """Score the actor on the validation buildings, log the row, and write `policy.pt` when it is the best
@@ -339,6 +346,10 @@ def validate_checkpoint(validator: LatticeValidator, run: Path, config: TrainCon
     scores = validator.score(actor_weights(loss_state))
     set_rng_state(state)
     score = float(sum(scores.values()) / len(scores))
+    if config.validation.validation_keep:
+        kept = validated_policy(run, counters["frames"])
+        kept.parent.mkdir(exist_ok=True)
+        save_policy(kept, json.dumps(config_record(config)), loss_state, counters)
     if best is None or score > best["score"]:
         save_policy(run / POLICY, json.dumps(config_record(config)), loss_state, counters)
         best = {"frames": counters["frames"], "score": score}

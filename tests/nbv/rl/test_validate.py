@@ -65,7 +65,8 @@ def test_score_is_the_visible_coverage_of_the_modes_lattice_views(tmp_path, cach
 def test_validated_training_keeps_the_best_policy_and_trains_as_without(tmp_path, cache):
     unvalidated = replace(validated(tmp_path / "plain", 6), validation=ValidationConfig())
     plain = load_checkpoint(train_run(unvalidated))
-    ckpt = load_checkpoint(train_run(validated(tmp_path / "run", 6)))
+    keeping = replace(VALIDATION, validation_keep=True)  # every validated actor kept besides the best
+    ckpt = load_checkpoint(train_run(validated(tmp_path / "run", 6, keeping)))
     for key in plain["loss"]:  # validation consumes none of the training's random numbers
         assert torch.equal(plain["loss"][key], ckpt["loss"][key]), key
     assert "validation" not in plain
@@ -81,8 +82,14 @@ def test_validated_training_keeps_the_best_policy_and_trains_as_without(tmp_path
     policy = torch.load(tmp_path / "run" / "policy.pt", weights_only=True)
     assert policy["counters"]["frames"] == 2 * (best + 1)
     config = validated(tmp_path, 6)
-    rescored = LatticeValidator(config.env, VALIDATION, config.network).score(weights)
-    assert rescored["test_building"] == pytest.approx(means[best], abs=1e-3)
+    validator = LatticeValidator(config.env, VALIDATION, config.network)
+    assert validator.score(weights)["test_building"] == pytest.approx(means[best], abs=1e-3)
+    kept = sorted(p.name for p in (tmp_path / "run" / "validated").iterdir())  # every validated actor
+    assert kept == ["policy_000002.pt", "policy_000004.pt", "policy_000006.pt"]
+    for name, mean in zip(kept, means):
+        assert validator.score(load_policy(tmp_path / "run" / "validated" / name)[1])["test_building"] == \
+            pytest.approx(mean, abs=1e-3)
+    assert not (tmp_path / "plain" / "validated").exists()
 
 
 def test_bad_validation_settings_are_refused():

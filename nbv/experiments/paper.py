@@ -322,6 +322,8 @@ INDEX = (
            "12's two changes together, two seeds", LOOKS_EVAL),
     Result("selection/round14/README.md", "selection/round14/results.json", "its fourteenth round: the "
            "default command's members trained on to 9000 frames", LOOKS_EVAL),
+    Result("selection/round15/README.md", "selection/round15/results.json", "its fifteenth round: the "
+           "default command on twice the training buildings", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

@@ -324,6 +324,8 @@ INDEX = (
            "default command's members trained on to 9000 frames", LOOKS_EVAL),
     Result("selection/round15/README.md", "selection/round15/results.json", "its fifteenth round: the "
            "default command on twice the training buildings", LOOKS_EVAL),
+    Result("selection/round16/README.md", "selection/round16/results.json", "its sixteenth round: forward "
+           "actions (the azimuth always advancing), teacher and students", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

@@ -108,21 +108,23 @@ def summarise(by_scene: dict[str, dict], scenes: list[str], seeds: list[int]) ->
 
 
 def evaluate(planners: dict[str, tuple[Planner, bool]], trained: EnvConfig, scenes: list[str],
-             seeds: list[int], views: int, work: Path) -> dict:
-    """Every planner's runs and summary; each (planner, building) kept in `work/NAME/SCENE.json` and reused
-    while its key holds (so buildings can be scored by processes side by side, then gathered)."""
+             seeds: list[int], views: int, work: Path, blank_images: bool = True) -> dict:
+    """Every planner's runs and summary (policies also with blank images, unless `blank_images` is off);
+    each (planner, building) kept in `work/NAME/SCENE.json` and reused while its key holds and it has
+    what is asked (so buildings can be scored by processes side by side, then gathered)."""
     scorer, results = Scorer(trained, views), {}
     for name, (planner, is_policy) in planners.items():
         checkpoint = Path(planner.checkpoint) if is_policy else None
         key = {"seeds": seeds, "views": views, "checkpoint": str(checkpoint),
                "mtime": checkpoint.stat().st_mtime if checkpoint else None}
         env = planner.env_config if is_policy else trained
-        blank = PolicyPlanner(checkpoint, blank_images=True) if is_policy else None
+        blank = PolicyPlanner(checkpoint, blank_images=True) if is_policy and blank_images else None
         by_scene = {}
         for scene in scenes:
             saved = work / name / f"{scene.replace(':', '_')}.json"
-            if saved.is_file() and json.loads(saved.read_text())["key"] == key:
-                by_scene[scene] = json.loads(saved.read_text())["result"]
+            doc = json.loads(saved.read_text()) if saved.is_file() else None
+            if doc is not None and doc["key"] == key and (blank is None or doc["result"]["blank"]):
+                by_scene[scene] = doc["result"]
                 continue
             by_scene[scene] = score_scene(scorer, planner, env, scene, seeds, blank)
             saved.parent.mkdir(parents=True, exist_ok=True)
@@ -175,6 +177,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--policy", action="append", default=[], metavar="NAME=PATH", required=True)
     parser.add_argument("--baselines", nargs="*", default=["orbit", "random"])
+    parser.add_argument("--no-blank", action="store_true",
+                        help="skip the blank-image flights (a quicker screen of many policies)")
     study_arguments(parser)
     args = parser.parse_args()
     refuse_held_out(args.scenes)
@@ -183,7 +187,7 @@ def main() -> None:
     planners = {name: (p, True) for name, p in policies.items()}
     planners |= {name: (make_planner(name, PlanSettings(), seed=0), False) for name in args.baselines}
     args.work.mkdir(parents=True, exist_ok=True)
-    results = evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work)
+    results = evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work, not args.no_blank)
     table = report(results, args.scenes, args.seeds, args.views, args.baselines[0] if args.baselines else
                    next(iter(policies)))
     outputs = ("results.json", "results.md", "coverage.png")

@@ -1,0 +1,161 @@
+"""Can the student follow its teacher at all? DAgger on the training buildings (issue 26, round 18).
+
+The default's students are trained by SAC with an imitation term (docs/rl.md §4) on batches of 8, one
+gradient step per frame: 6000 steps in all, and the squared distance between the actor's mode and the
+teacher's action stays near 0.5 to 1.0 (per state, summed over the three action values in [-1, 1]).
+This trains the same actor by supervision alone (Ross et al. 2011, DAgger). The pool of labelled
+states starts from `--buffers`: training checkpoints' replay buffers, whose every state carries the
+teacher's label (states SAC's actors and exploration visited; a share `--held` is kept aside and never
+fitted). Then each iteration flies `--episodes` episodes (the teacher's own actions in iteration 0 when
+the pool starts empty, else the student's mode), labels every state visited with the teacher's action
+(`nbv.rl.expert`, read by the training env) and adds them to the pool; after the seed states and after
+every iteration the actor's mode is fitted to the whole pool (mean squared error, Adam, `--epochs`
+passes). The loss on newly flown states before fitting them is the student's error on its own states;
+the loss on the held states is its error on states it never fitted. No reward, no critic: the question
+is whether the images and poses carry what the teacher knows, given enough updates.
+
+Writes OUT/policy.pt (a policy file `nbv plan --planner policy:OUT/policy.pt` and `scripts/looks_eval.py`
+read), OUT/dagger.json (per iteration: states, on-policy loss, fitted loss) and OUT/config.json. The
+training env is `nbv train`'s with the flags after `--` (default: the default preset's):
+
+    python scripts/dagger.py --out RUN18 --iterations 0 --epochs 8 \
+        --buffers RUNS/default/member0/checkpoint.pt
+    python scripts/dagger.py --out RUN18B --iterations 4 --episodes 60 -- --action-mode forward \
+        --relative-step 0.15384615
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import torch
+from tensordict import TensorDict
+from torchrl.envs.utils import ExplorationType, set_exploration_type
+from tqdm import tqdm
+
+from common.io import write_json
+from common.provenance import config_record, git_commit, portable_record
+from common.threads import set_torch_threads
+from nbv.cli.train import parse_train
+from nbv.rl.builders import make_environment, make_loss_module, make_sac_agent
+from nbv.rl.checkpoint import save_policy
+from nbv.rl.expert import EXPERT_KEY
+
+
+def visit(env, actor, episodes: int, teacher: bool, desc: str) -> list[TensorDict]:
+    """The states of `episodes` episodes flown by the teacher's actions or the actor's mode, each with the
+    teacher's label (the observation keys the actor reads, and `EXPERT_KEY`)."""
+    keys = [*actor.in_keys, EXPERT_KEY]
+    states = []
+    with torch.no_grad(), set_exploration_type(ExplorationType.DETERMINISTIC):
+        for _ in tqdm(range(episodes), desc=desc, unit="episode"):
+            td = env.reset()
+            done = False
+            while not done:
+                states.append(td.select(*keys).clone())
+                td = env.step(td.set("action", td[EXPERT_KEY]) if teacher else actor(td))
+                done = bool(td["next", "done"])
+                td = td["next"]
+    return states
+
+
+def buffer_states(path: Path, keys: list[str], last: int) -> list[TensorDict]:
+    """The labelled states of a training checkpoint's replay buffer (its `last` newest; 0: all): the
+    states SAC's own actor and exploration visited, each with the teacher's label."""
+    stored = torch.load(path, weights_only=True, map_location="cpu")["buffer"]["_storage"]["_storage"]
+    return [TensorDict({k: item[k] for k in keys}, []) for item in stored[-last if last else 0:]]
+
+
+def mode_error(actor, batch: TensorDict) -> torch.Tensor:
+    """Mean over states of the squared distance between the actor's mode and the teacher's action."""
+    dist = actor.get_dist(batch.select(*actor.in_keys))
+    return ((dist.deterministic_sample - batch[EXPERT_KEY]) ** 2).sum(-1).mean()
+
+
+def fit(actor, optimiser, data: TensorDict, held: TensorDict | None, epochs: int, batch: int,
+        generator: torch.Generator) -> list[dict]:
+    """`epochs` passes of minibatch Adam on `mode_error` over `data`; per pass, the mean training loss and
+    the loss on the `held` states (never fitted), if any."""
+    passes = []
+    for _ in tqdm(range(epochs), desc=f"fitting {len(data)} states", unit="pass"):
+        order, losses = torch.randperm(len(data), generator=generator), []
+        for start in range(0, len(data), batch):
+            loss = mode_error(actor, data[order[start:start + batch]])
+            optimiser.zero_grad()
+            loss.backward()
+            optimiser.step()
+            losses.append(loss.item())
+        with torch.no_grad():
+            passes.append({"train": float(sum(losses) / len(losses)),
+                           "held": mode_error(actor, held).item() if held is not None else None})
+    return passes
+
+
+def main(argv: list[str]) -> int:
+    cut = argv.index("--") if "--" in argv else len(argv)
+    ours, train_args = argv[:cut], argv[cut + 1:]
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--iterations", type=int, default=4)
+    parser.add_argument("--episodes", type=int, default=60, help="episodes flown per iteration")
+    parser.add_argument("--epochs", type=int, default=8, help="passes over the pooled states per iteration")
+    parser.add_argument("--batch", type=int, default=64)
+    parser.add_argument("--lr", type=float, default=1e-3)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--buffers", nargs="*", type=Path, default=[], metavar="CHECKPOINT[:LAST]",
+                        help="training checkpoints whose replay buffers' labelled states seed the pool")
+    parser.add_argument("--held", type=float, default=0.1, help="share of the seed states never fitted")
+    args = parser.parse_args(ours)
+    config = parse_train([*train_args, "--out", str(args.out)])
+    if config.reward.imitation <= 0:
+        raise SystemExit("the training env labels states with the teacher only with --imitation > 0")
+    args.out.mkdir(parents=True, exist_ok=True)
+    set_torch_threads(config.collector.threads)
+    torch.manual_seed(args.seed)
+    env = make_environment(config.env, 1, args.seed, config.reward) if args.iterations else None
+    actor, critic = make_sac_agent(config.env, config.network)
+    loss_module, _ = make_loss_module(actor, critic, config.optim)  # its state dict shares the actor's
+    optimiser = torch.optim.Adam(actor.parameters(), lr=args.lr)
+    generator = torch.Generator().manual_seed(args.seed)
+    keys = [*actor.in_keys, EXPERT_KEY]
+    pooled: list[TensorDict] = []
+    for spec in args.buffers:
+        path, _, last = str(spec).partition(":")
+        pooled += buffer_states(Path(path), keys, int(last or 0))
+    held = None
+    log = []
+    start = time.perf_counter()
+    if pooled:
+        order = torch.randperm(len(pooled), generator=generator).tolist()
+        cut = int(round(args.held * len(pooled)))
+        held = torch.stack([pooled[i] for i in order[:cut]]) if cut else None
+        pooled = [pooled[i] for i in order[cut:]]
+        log.append({"iteration": "buffers", "states": len(pooled), "held_states": cut,
+                    "passes": fit(actor, optimiser, torch.stack(pooled), held, args.epochs, args.batch,
+                                  generator), "seconds": round(time.perf_counter() - start, 1)})
+        print(log[-1], flush=True)
+    for iteration in range(args.iterations):
+        teacher = iteration == 0 and not pooled  # with seed states the student flies from the start
+        new = visit(env, actor, args.episodes, teacher, f"iteration {iteration}")
+        with torch.no_grad():
+            on_policy = mode_error(actor, torch.stack(new)).item()
+        pooled += new
+        log.append({"iteration": iteration, "states": len(pooled), "teacher_flies": teacher,
+                    "loss_on_new_states": on_policy,
+                    "passes": fit(actor, optimiser, torch.stack(pooled), held, args.epochs, args.batch,
+                                  generator), "seconds": round(time.perf_counter() - start, 1)})
+        print(log[-1], flush=True)
+    counters = {"frames": len(pooled), "updates": args.iterations * args.epochs}
+    save_policy(args.out / "policy.pt", json.dumps(config_record(config)), loss_module.state_dict(), counters)
+    write_json(args.out / "config.json", config_record(config))
+    write_json(args.out / "dagger.json", portable_record({
+        "commit": git_commit(), "command": ["scripts/dagger.py", *argv], "iterations": log}))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

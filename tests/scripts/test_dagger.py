@@ -1,0 +1,55 @@
+"""`scripts/dagger.py`'s pieces on synthetic states: the replay buffer read back, the fit to the labels."""
+
+from __future__ import annotations
+
+import importlib.util
+from collections import OrderedDict
+from pathlib import Path
+
+import torch
+from tensordict import TensorDict
+
+from nbv.rl.builders import make_sac_agent
+from nbv.rl.config import EnvConfig, NetworkConfig
+from nbv.rl.expert import EXPERT_KEY
+from scenes.spec import SceneSet
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def dagger():
+    spec = importlib.util.spec_from_file_location("dagger", ROOT / "scripts" / "dagger.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def states(count: int, label: list[float]) -> list[TensorDict]:
+    gen = torch.Generator().manual_seed(0)
+    return [TensorDict({"pixels": torch.randint(0, 255, (5, 16, 16), generator=gen, dtype=torch.uint8),
+                        "viewpoints": torch.rand(5, 3, generator=gen) * 2 - 1,
+                        EXPERT_KEY: torch.tensor(label)}, []) for _ in range(count)]
+
+
+def test_buffer_states_reads_the_newest_labelled_states_of_a_checkpoint(tmp_path):
+    items = [OrderedDict(pixels=torch.full((5, 16, 16), i, dtype=torch.uint8), viewpoints=torch.zeros(5, 3),
+                         expert_action=torch.full((3,), i / 10), reward=torch.ones(1)) for i in range(4)]
+    torch.save({"buffer": {"_storage": {"_storage": items}}}, tmp_path / "checkpoint.pt")
+    read = dagger().buffer_states(tmp_path / "checkpoint.pt", ["pixels", "viewpoints", EXPERT_KEY], 2)
+    assert [int(s["pixels"][0, 0, 0]) for s in read] == [2, 3]  # the two newest
+    assert set(read[0].keys()) == {"pixels", "viewpoints", EXPERT_KEY}
+    assert len(dagger().buffer_states(tmp_path / "checkpoint.pt", ["pixels"], 0)) == 4
+
+
+def test_fitting_brings_the_mode_to_the_teachers_labels_on_states_never_fitted():
+    module = dagger()
+    torch.manual_seed(0)
+    env = EnvConfig(scenes=SceneSet(scene=("test_building",)), obs_size=16)
+    actor, _ = make_sac_agent(env, NetworkConfig(channels=4, hidden=16, location_hidden=8))
+    label = [0.5, -0.5, 0.25]
+    data, held = torch.stack(states(32, label)), torch.stack(states(8, label))
+    before = module.mode_error(actor, held).item()
+    passes = module.fit(actor, torch.optim.Adam(actor.parameters(), lr=1e-2), data, held, 30, 8,
+                        torch.Generator().manual_seed(0))
+    assert len(passes) == 30 and passes[-1]["train"] < passes[0]["train"]
+    assert passes[-1]["held"] < 0.05 < before

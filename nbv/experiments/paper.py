@@ -326,6 +326,8 @@ INDEX = (
            "default command on twice the training buildings", LOOKS_EVAL),
     Result("selection/round16/README.md", "selection/round16/results.json", "its sixteenth round: forward "
            "actions (the azimuth always advancing), teacher and students", LOOKS_EVAL),
+    Result("selection/round17/README.md", "selection/round17/results.json", "its seventeenth round: 28 "
+           "buildings, two more seeds, checkpoints chosen by the exact-render checks", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

@@ -284,6 +284,10 @@ class ValidationConfig:
     """Views per validation episode, the start view included."""
     validation_points: int = 20_000
     """True-surface samples of the coverage score per building."""
+    validation_max_metres: float = 0.0
+    """Beyond the paper: an actor whose validation flights average more metres than this (along the
+    viewing shell) is kept as `policy.pt`, or as a command's member, only while no actor within it has
+    been; 0: no bar, the best score wins (issue 26's metres check: 1.5x the tuned ring's metres)."""
     validation_keep: bool = False
     """Also write every validated actor to `validated/policy_FRAMES.pt` in the run folder, so a checkpoint
     can be chosen afterwards by other checks than the lattice score (exact renders, metres, blank images:
@@ -293,6 +297,14 @@ class ValidationConfig:
         for name in ("validation_episodes", "validation_views", "validation_points"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
+        if not self.validation_max_metres >= 0:
+            raise ValueError(f"validation_max_metres must be >= 0, got {self.validation_max_metres}")
+
+    def rank(self, score: float, metres: float | None) -> tuple[bool, float]:
+        """The order actors are kept in: within `validation_max_metres` (or no bar, or metres unknown)
+        first, then the higher score."""
+        within = self.validation_max_metres <= 0 or metres is None or metres <= self.validation_max_metres
+        return within, score
 
     @property
     def enabled(self) -> bool:

@@ -44,13 +44,16 @@ def member_config(config: TrainConfig, member: int) -> TrainConfig:
                                   progress=config.logger.progress and config.executor.workers == 1))
 
 
-def best_validation(path: Path) -> dict[str, float]:
-    """The {"frames", "score"} of the actor a run's `policy.pt` holds, from its validation.csv (the last
-    row names it) rather than from the checkpoint, which carries the whole replay buffer."""
+def best_validation(path: Path) -> dict[str, float | None]:
+    """The {"frames", "score", "metres"} of the actor a run's `policy.pt` holds, from its validation.csv
+    (the last row names it; metres None in logs written before they were) rather than from the
+    checkpoint, which carries the whole replay buffer."""
     with open(path, newline="") as file:
         rows = list(csv.DictReader(file))
     frames = int(rows[-1]["best_frames"])
-    return {"frames": frames, "score": next(float(r["mean"]) for r in rows if int(r["frames"]) == frames)}
+    row = next(r for r in rows if int(r["frames"]) == frames)
+    metres = row.get("metres")
+    return {"frames": frames, "score": float(row["mean"]), "metres": float(metres) if metres else None}
 
 
 def train_members(config: TrainConfig) -> Path:
@@ -67,7 +70,8 @@ def train_members(config: TrainConfig) -> Path:
               disable=not config.logger.progress) as bar:
         run_tasks(tasks, config.executor, on_done=lambda task: bar.update())
     best = [best_validation(Path(m.logger.out) / VALIDATION_CSV) for m in members]
-    kept = max(range(len(members)), key=lambda k: (best[k]["score"], -k))  # ties: the lower seed
+    rank = config.validation.rank  # within the metres bar first, then score; ties: the lower seed
+    kept = max(range(len(members)), key=lambda k: (*rank(best[k]["score"], best[k]["metres"]), -k))
     copy_policy(Path(members[kept].logger.out) / POLICY, run / POLICY, config_record(config))
     with open(run / MEMBERS_CSV, "w", newline="") as file:
         log = csv.writer(file)

@@ -340,19 +340,21 @@ def validated_policy(run: Path, frames: int) -> Path:
 def validate_checkpoint(validator: LatticeValidator, run: Path, config: TrainConfig, loss_state: dict,
                         counters: dict[str, int], best: dict | None) -> dict:
     """Score the actor on the validation buildings, log the row, and write `policy.pt` when it is the best
-    so far (ties keep the earlier actor); return the best {"frames", "score"}. The global random states
+    so far (`ValidationConfig.rank`: within the metres bar, then score; ties keep the earlier actor);
+    return the best {"frames", "score", "metres"}. The global random states
     are kept, so a validated run trains exactly as an unvalidated one."""
     state = rng_state()
-    scores = validator.score(actor_weights(loss_state))
+    scores, metres = validator.score_and_metres(actor_weights(loss_state))
     set_rng_state(state)
     score = float(sum(scores.values()) / len(scores))
+    rank = config.validation.rank
     if config.validation.validation_keep:
         kept = validated_policy(run, counters["frames"])
         kept.parent.mkdir(exist_ok=True)
         save_policy(kept, json.dumps(config_record(config)), loss_state, counters)
-    if best is None or score > best["score"]:
+    if best is None or rank(score, metres) > rank(best["score"], best.get("metres")):
         save_policy(run / POLICY, json.dumps(config_record(config)), loss_state, counters)
-        best = {"frames": counters["frames"], "score": score}
+        best = {"frames": counters["frames"], "score": score, "metres": metres}
     path = run / VALIDATION_CSV
     new = not path.is_file() or path.stat().st_size == 0
     with open(path, "a", newline="") as file:
@@ -360,7 +362,7 @@ def validate_checkpoint(validator: LatticeValidator, run: Path, config: TrainCon
         if new:
             log.writerow(validation_fields(list(scores)))
         log.writerow([counters["frames"], *(f"{v:.3f}" for v in scores.values()), f"{score:.3f}",
-                      best["frames"]])
+                      best["frames"], f"{metres:.3f}"])
     return best
 
 

@@ -21,6 +21,7 @@ from dataclasses import replace
 import numpy as np
 import torch
 
+from nbv.flight.record import flight_record
 from nbv.recon.visibility import SurfaceVisibility, scene_visibility
 from nbv.rl.agent import make_actor
 from nbv.rl.bov_observation import bov_observation_size
@@ -69,8 +70,13 @@ class LatticeValidator:
 
     def score(self, weights: dict[str, torch.Tensor]) -> dict[str, float]:
         """Visible coverage (%) of each validation building by the actor's mode, mean over the episodes."""
+        return self.score_and_metres(weights)[0]
+
+    def score_and_metres(self, weights: dict[str, torch.Tensor]) -> tuple[dict[str, float], float]:
+        """`score`, and the metres the mode flies per episode along the viewing shell from its start view
+        (`nbv.flight.record.flight_record`), mean over every building and episode."""
         self.actor.load_state_dict(weights)
-        scores = {}
+        scores, metres = {}, []
         for spec in self.config.scenes.specs():
             env = self._env(spec.scene)
             runs = []
@@ -78,8 +84,9 @@ class LatticeValidator:
                 env.set_seed(episode)
                 views = policy_views(self.actor, env, self.validation.validation_views)
                 runs.append(self._coverage(spec.scene, env, views))
+                metres.append(flight_record(views[0], views[1:])["flight_m"])
             scores[spec.scene] = 100.0 * float(np.mean(runs))
-        return scores
+        return scores, float(np.mean(metres))
 
     def _env(self, scene: str) -> NBVEnv:
         if scene not in self._envs:

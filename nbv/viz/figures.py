@@ -200,11 +200,11 @@ def plot_training_curves(runs: dict[str, str | Path], out: str | Path, window: i
         table = np.genfromtxt(path, delimiter=",", names=True, dtype=np.float64)
         frames, mean = np.atleast_1d(table["frames"]), np.atleast_1d(table["mean"])
         line, = axes[-1].plot(frames, mean, marker=".", label=label)
-        best = int(np.argmax(mean))
+        best = int(np.flatnonzero(frames == np.atleast_1d(table["best_frames"])[-1])[0])  # policy.pt's
         axes[-1].plot(frames[best], mean[best], "*", markersize=12, color=line.get_color())
     if validations:
         axes[-1].set(xlabel="frames (environment steps)", ylabel="visible coverage %",
-                     title="validation buildings (star: a run's best)")
+                     title="validation buildings (star: the actor kept)")
         axes[-1].grid(alpha=0.3)
     axes[0].legend(fontsize=8)
     return save_figure(fig, out)

@@ -42,7 +42,16 @@ def test_an_empty_or_headerless_log_gets_its_header_back(tmp_path):
 def test_rows_logged_twice_by_an_earlier_resume_are_kept_once(tmp_path):
     path = tmp_path / "validation.csv"
     header = validation_fields(["random:6"])
-    rows = [[str(f), "50.0", "50.0", "2"] for f in (2, 4, 6, 4, 6, 8)]
+    rows = [[str(f), "50.0", "50.0", "2", "12.5"] for f in (2, 4, 6, 4, 6, 8)]
     path.write_text("\n".join(",".join(r) for r in [header, *rows]) + "\n")
     trim_log(path, 8, header)
-    assert read(path) == (header, [[str(f), "50.0", "50.0", "2"] for f in (2, 4, 6, 8)])
+    assert read(path) == (header, [[str(f), "50.0", "50.0", "2", "12.5"] for f in (2, 4, 6, 8)])
+
+
+def test_a_log_from_before_the_metres_column_gets_it_and_keeps_its_rows(tmp_path):
+    path = tmp_path / "validation.csv"
+    header = validation_fields(["random:6"])
+    old = [header[:-1], ["2", "50.0", "50.0", "2"], ["4", "60.0", "60.0", "4"]]  # no metres yet
+    path.write_text("\n".join(",".join(r) for r in [*old, ["6", "55.0", "55.0", "4", "12.5"]]) + "\n")
+    trim_log(path, 6, header)  # a resumed run appended a row with metres
+    assert read(path) == (header, [old[1], old[2], ["6", "55.0", "55.0", "4", "12.5"]])

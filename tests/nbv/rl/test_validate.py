@@ -76,20 +76,34 @@ def test_validated_training_keeps_the_best_policy_and_trains_as_without(tmp_path
     assert [int(r["frames"]) for r in rows] == [2, 4, 6]
     means = [float(r["mean"]) for r in rows]
     best = int(np.argmax(means))  # the first of equal scores
-    assert ckpt["validation"] == {"frames": 2 * (best + 1), "score": pytest.approx(means[best], abs=1e-3)}
+    assert ckpt["validation"] == {"frames": 2 * (best + 1), "score": pytest.approx(means[best], abs=1e-3),
+                                  "metres": pytest.approx(float(rows[best]["metres"]), abs=1e-3)}
     assert all(int(r["best_frames"]) <= int(r["frames"]) for r in rows)
     _, weights = load_policy(tmp_path / "run" / "policy.pt")
     policy = torch.load(tmp_path / "run" / "policy.pt", weights_only=True)
     assert policy["counters"]["frames"] == 2 * (best + 1)
     config = validated(tmp_path, 6)
     validator = LatticeValidator(config.env, VALIDATION, config.network)
-    assert validator.score(weights)["test_building"] == pytest.approx(means[best], abs=1e-3)
+    scores, metres = validator.score_and_metres(weights)
+    assert scores["test_building"] == pytest.approx(means[best], abs=1e-3)
+    assert float(rows[best]["metres"]) == pytest.approx(metres, abs=1e-3) and metres > 0  # flown, logged
     kept = sorted(p.name for p in (tmp_path / "run" / "validated").iterdir())  # every validated actor
     assert kept == ["policy_000002.pt", "policy_000004.pt", "policy_000006.pt"]
     for name, mean in zip(kept, means):
         assert validator.score(load_policy(tmp_path / "run" / "validated" / name)[1])["test_building"] == \
             pytest.approx(mean, abs=1e-3)
     assert not (tmp_path / "plain" / "validated").exists()
+
+
+def test_actors_within_the_metres_bar_are_kept_first_then_the_best_score():
+    capped = ValidationConfig(validation_scenes=("test_building",), validation_max_metres=13.0)
+    assert capped.rank(90.0, 12.0) > capped.rank(93.0, 16.0)  # the long flight loses whatever it covers
+    assert capped.rank(91.0, 12.9) > capped.rank(90.0, 8.0)  # both within: the better score
+    assert capped.rank(93.0, 17.0) > capped.rank(92.0, 16.0)  # none within: the better score
+    assert capped.rank(90.0, None) > capped.rank(89.0, 5.0)  # metres unknown (an older log): within
+    assert VALIDATION.rank(93.0, 16.0) > VALIDATION.rank(90.0, 12.0)  # no bar: the score alone
+    with pytest.raises(ValueError, match="validation_max_metres must be >= 0"):
+        ValidationConfig(validation_max_metres=-1.0)
 
 
 def test_bad_validation_settings_are_refused():

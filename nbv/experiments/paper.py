@@ -328,6 +328,8 @@ INDEX = (
            "actions (the azimuth always advancing), teacher and students", LOOKS_EVAL),
     Result("selection/round17/README.md", "selection/round17/results.json", "its seventeenth round: 28 "
            "buildings, two more seeds, checkpoints chosen by the exact-render checks", LOOKS_EVAL),
+    Result("selection/round18/README.md", "selection/round18/results.json", "its eighteenth round: the "
+           "student fitted to its teacher's labels by supervision alone (scripts/dagger.py)", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

@@ -1,5 +1,5 @@
 """Every kept actor of a run (`nbv train --validation-keep`) scored again as its validation scored it:
-lattice coverage (%) and metres flown per episode (issue 26, round 17).
+lattice coverage (%) and metres flown per episode (issue 26, round 17), or with `--exact` on exact renders.
 
 Written to OUT as JSON: per member folder and actor file, [mean score, metres]. The validation settings
 are the run's own (its config.json):
@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 from tqdm import tqdm
@@ -27,8 +28,10 @@ def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--run", type=Path, required=True)
     parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--exact", action="store_true", help="fly exact renders, not the view lattices")
     args = parser.parse_args(argv)
     config = config_from_record(TrainConfig, json.loads((args.run / "config.json").read_text()))
+    config = replace(config, validation=replace(config.validation, validation_exact=args.exact))
     validator = LatticeValidator(config.env, config.validation, config.network)
     actors = sorted(args.run.glob("**/validated/policy_*.pt"))
     if not actors:

@@ -30,6 +30,6 @@ def render_lattices(config: TrainConfig) -> None:
     """Render the training (--lattice) and validation buildings' view lattices not cached yet, side by side
     where the executor says, so envs and members then read the cache instead of each rendering them."""
     tasks = lattice_tasks(config.env) if config.env.lattice.enabled else []
-    if config.validation.enabled:
+    if config.validation.enabled and not config.validation.validation_exact:
         tasks += lattice_tasks(validation_env_config(config.env, config.validation))
     run_tasks(tasks, config.executor)

@@ -288,6 +288,11 @@ class ValidationConfig:
     """Beyond the paper: an actor whose validation flights average more metres than this (along the
     viewing shell) is kept as `policy.pt`, or as a command's member, only while no actor within it has
     been; 0: no bar, the best score wins (issue 26's metres check: 1.5x the tuned ring's metres)."""
+    validation_exact: bool = False
+    """Beyond the paper: fly the validation episodes on exact renders at the training settings instead of
+    the buildings' view lattices (views x episodes x buildings renders a checkpoint: 156 at the defaults),
+    so the score and the metres are those the exact-render checks measure (on the lattice the nearest
+    node's frame moves the actions: paper_results/selection/round17)."""
     validation_keep: bool = False
     """Also write every validated actor to `validated/policy_FRAMES.pt` in the run folder, so a checkpoint
     can be chosen afterwards by other checks than the lattice score (exact renders, metres, blank images:

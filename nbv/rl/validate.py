@@ -34,9 +34,10 @@ from scenes.spec import SceneSet
 
 
 def validation_env_config(env: EnvConfig, validation: ValidationConfig) -> EnvConfig:
-    """The training env on the validation buildings, on view lattices (the training lattice settings)."""
+    """The training env on the validation buildings, on view lattices (the training lattice settings), or
+    on exact renders with `validation_exact`."""
     scenes = SceneSet(scene=validation.validation_scenes, up_axis=env.scenes.up_axis)
-    return replace(env, scenes=scenes, lattice=replace(env.lattice, enabled=True))
+    return replace(env, scenes=scenes, lattice=replace(env.lattice, enabled=not validation.validation_exact))
 
 
 def evaluation_env_config(trained: EnvConfig, scenes: SceneSet, render: RenderSettings | None = None,

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 import torch
 
+from nbv.flight.record import flight_record
 from nbv.recon.visibility import scene_visibility
 from nbv.rl.agent import make_actor
 from nbv.rl.checkpoint import load_checkpoint, load_policy
@@ -39,17 +40,19 @@ def validated(out, frames: int, validation: ValidationConfig = VALIDATION):
                    logger=replace(config.logger, checkpoint_every=2))
 
 
-def test_score_is_the_visible_coverage_of_the_modes_lattice_views(tmp_path, cache):
+@pytest.mark.parametrize("exact", [False, True])
+def test_score_is_the_visible_coverage_of_the_modes_views(tmp_path, cache, exact):
     config = validated(tmp_path, 2)
+    validation = replace(VALIDATION, validation_exact=exact)  # exact: rendered, not the lattice's frames
     actor = make_actor(config.env.history, config.env.obs_size, config.network)
     weights = actor.state_dict()
-    scores = LatticeValidator(config.env, VALIDATION, config.network).score(weights)
+    scores, metres = LatticeValidator(config.env, validation, config.network).score_and_metres(weights)
 
-    env_config = validation_env_config(config.env, VALIDATION)
-    assert env_config.lattice.enabled and env_config.scenes.scene == ("test_building",)
+    env_config = validation_env_config(config.env, validation)
+    assert env_config.lattice.enabled == (not exact) and env_config.scenes.scene == ("test_building",)
     env = NBVEnv(env_config)
     visibility = None
-    coverages = []
+    coverages, flown = [], []
     for episode in range(2):
         env.set_seed(episode)
         views = policy_views(actor, env, 3)
@@ -57,9 +60,11 @@ def test_score_is_the_visible_coverage_of_the_modes_lattice_views(tmp_path, cach
         visibility = visibility or scene_visibility(env.scene, env_config.camera, 2000)
         poses = [viewpoint_to_c2w(v, env.scene.center()) for v in views]
         coverages.append(visibility.coverage(poses))
+        flown.append(flight_record(views[0], views[1:])["flight_m"])
     assert list(scores) == ["test_building"]
     assert scores["test_building"] == pytest.approx(100 * np.mean(coverages))
-    assert 0 < scores["test_building"] <= 100
+    assert 0 < scores["test_building"] <= 100 and metres == pytest.approx(np.mean(flown))
+    assert (tmp_path / "cache" / "lattice").exists() == (not exact)  # exact validation needs no lattice
 
 
 def test_validated_training_keeps_the_best_policy_and_trains_as_without(tmp_path, cache):

@@ -16,12 +16,12 @@ is whether the images and poses carry what the teacher knows, given enough updat
 
 Writes OUT/policy.pt (a policy file `nbv plan --planner policy:OUT/policy.pt` and `scripts/looks_eval.py`
 read), OUT/dagger.json (per iteration: states, on-policy loss, fitted loss) and OUT/config.json. The
-training env is `nbv train`'s with the flags after `--` (default: the default preset's):
+training env is `nbv train --preset PRESET --scene ...`'s (default: the default preset's buildings):
 
     python scripts/dagger.py --out RUN18 --iterations 0 --epochs 8 \
         --buffers RUNS/default/member0/checkpoint.pt
-    python scripts/dagger.py --out RUN18B --iterations 4 --episodes 60 -- --action-mode forward \
-        --relative-step 0.15384615
+    python scripts/dagger.py --out RUN18B --iterations 4 --episodes 60 --scene medieval_tavern \
+        --scene random:1
 """
 
 from __future__ import annotations
@@ -30,6 +30,7 @@ import argparse
 import json
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import torch
@@ -40,10 +41,13 @@ from tqdm import tqdm
 from common.io import write_json
 from common.provenance import config_record, git_commit, portable_record
 from common.threads import set_torch_threads
-from nbv.cli.train import parse_train
 from nbv.rl.builders import make_environment, make_loss_module, make_sac_agent
 from nbv.rl.checkpoint import save_policy
+from nbv.rl.config import TrainConfig
 from nbv.rl.expert import EXPERT_KEY
+from nbv.rl.presets import PRESETS
+from nbv.rl.train import mode_distance
+from scenes.spec import SceneSet
 
 
 def visit(env, actor, episodes: int, teacher: bool, desc: str) -> list[TensorDict]:
@@ -70,34 +74,35 @@ def buffer_states(path: Path, keys: list[str], last: int) -> list[TensorDict]:
     return [TensorDict({k: item[k] for k in keys}, []) for item in stored[-last if last else 0:]]
 
 
-def mode_error(actor, batch: TensorDict) -> torch.Tensor:
-    """Mean over states of the squared distance between the actor's mode and the teacher's action."""
-    dist = actor.get_dist(batch.select(*actor.in_keys))
-    return ((dist.deterministic_sample - batch[EXPERT_KEY]) ** 2).sum(-1).mean()
+def train_config(preset: str, scenes: list[str], out: Path) -> TrainConfig:
+    """`nbv train --preset PRESET [--scene S ...] --out OUT`'s config (the given scenes replace the
+    preset's), built from the presets themselves: a script does not import the command line."""
+    config = PRESETS[preset]()
+    if scenes:
+        config = replace(config, env=replace(config.env, scenes=SceneSet(scene=tuple(scenes))))
+    return replace(config, logger=replace(config.logger, out=out))
 
 
 def fit(actor, optimiser, data: TensorDict, held: TensorDict | None, epochs: int, batch: int,
         generator: torch.Generator) -> list[dict]:
-    """`epochs` passes of minibatch Adam on `mode_error` over `data`; per pass, the mean training loss and
+    """`epochs` passes of minibatch Adam on `mode_distance` over `data`; per pass, the mean training loss and
     the loss on the `held` states (never fitted), if any."""
     passes = []
     for _ in tqdm(range(epochs), desc=f"fitting {len(data)} states", unit="pass"):
         order, losses = torch.randperm(len(data), generator=generator), []
         for start in range(0, len(data), batch):
-            loss = mode_error(actor, data[order[start:start + batch]])
+            loss = mode_distance(actor, data[order[start:start + batch]])
             optimiser.zero_grad()
             loss.backward()
             optimiser.step()
             losses.append(loss.item())
         with torch.no_grad():
             passes.append({"train": float(sum(losses) / len(losses)),
-                           "held": mode_error(actor, held).item() if held is not None else None})
+                           "held": mode_distance(actor, held).item() if held is not None else None})
     return passes
 
 
 def main(argv: list[str]) -> int:
-    cut = argv.index("--") if "--" in argv else len(argv)
-    ours, train_args = argv[:cut], argv[cut + 1:]
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, required=True)
     parser.add_argument("--iterations", type=int, default=4)
@@ -109,8 +114,11 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--buffers", nargs="*", type=Path, default=[], metavar="CHECKPOINT[:LAST]",
                         help="training checkpoints whose replay buffers' labelled states seed the pool")
     parser.add_argument("--held", type=float, default=0.1, help="share of the seed states never fitted")
-    args = parser.parse_args(ours)
-    config = parse_train([*train_args, "--out", str(args.out)])
+    parser.add_argument("--preset", choices=tuple(PRESETS), default="default", help="nbv train's preset")
+    parser.add_argument("--scene", action="append", default=[], help="a training building (repeat; "
+                        "given ones replace the preset's, as with nbv train)")
+    args = parser.parse_args(argv)
+    config = train_config(args.preset, args.scene, args.out)
     if config.reward.imitation <= 0:
         raise SystemExit("the training env labels states with the teacher only with --imitation > 0")
     args.out.mkdir(parents=True, exist_ok=True)
@@ -142,7 +150,7 @@ def main(argv: list[str]) -> int:
         teacher = iteration == 0 and not pooled  # with seed states the student flies from the start
         new = visit(env, actor, args.episodes, teacher, f"iteration {iteration}")
         with torch.no_grad():
-            on_policy = mode_error(actor, torch.stack(new)).item()
+            on_policy = mode_distance(actor, torch.stack(new)).item()
         pooled += new
         log.append({"iteration": iteration, "states": len(pooled), "teacher_flies": teacher,
                     "loss_on_new_states": on_policy,

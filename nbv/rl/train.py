@@ -300,12 +300,17 @@ def checkpoint_run(run: Path, config: TrainConfig, learner: Learner, frames: int
     return best
 
 
-def imitation_loss(loss_module: SACLoss, sample: TensorDictBase) -> torch.Tensor:
-    """Mean squared distance between the actor's mode and the teacher's action (`nbv.rl.expert`) over a
-    replay sample."""
-    with loss_module.actor_network_params.to_module(loss_module.actor_network, preserve_module_state=False):
-        dist = loss_module.actor_network.get_dist(sample.select(*loss_module.actor_network.in_keys))
+def mode_distance(actor: ProbabilisticActor, sample: TensorDictBase) -> torch.Tensor:
+    """Mean over the sample's states of the squared distance between the actor's mode and the teacher's
+    action (`nbv.rl.expert`), summed over the action's values."""
+    dist = actor.get_dist(sample.select(*actor.in_keys))
     return ((dist.deterministic_sample - sample[EXPERT_KEY]) ** 2).sum(-1).mean()
+
+
+def imitation_loss(loss_module: SACLoss, sample: TensorDictBase) -> torch.Tensor:
+    """`mode_distance` of the loss module's actor (its trained parameters) over a replay sample."""
+    with loss_module.actor_network_params.to_module(loss_module.actor_network, preserve_module_state=False):
+        return mode_distance(loss_module.actor_network, sample)
 
 
 def sac_update(loss_module: SACLoss, optim_actor: torch.optim.Optimizer, optim_critic: torch.optim.Optimizer,
@@ -347,13 +352,13 @@ def validate_checkpoint(validator: LatticeValidator, run: Path, config: TrainCon
     scores, metres = validator.score_and_metres(actor_weights(loss_state))
     set_rng_state(state)
     score = float(sum(scores.values()) / len(scores))
-    rank = config.validation.rank
+    rank, record = config.validation.rank, json.dumps(config_record(config))
     if config.validation.validation_keep:
         kept = validated_policy(run, counters["frames"])
         kept.parent.mkdir(exist_ok=True)
-        save_policy(kept, json.dumps(config_record(config)), loss_state, counters)
+        save_policy(kept, record, loss_state, counters)
     if best is None or rank(score, metres) > rank(best["score"], best.get("metres")):
-        save_policy(run / POLICY, json.dumps(config_record(config)), loss_state, counters)
+        save_policy(run / POLICY, record, loss_state, counters)
         best = {"frames": counters["frames"], "score": score, "metres": metres}
     path = run / VALIDATION_CSV
     new = not path.is_file() or path.stat().st_size == 0

@@ -12,6 +12,7 @@ from tensordict import TensorDict
 from nbv.rl.builders import make_sac_agent
 from nbv.rl.config import EnvConfig, NetworkConfig
 from nbv.rl.expert import EXPERT_KEY
+from nbv.rl.train import mode_distance
 from scenes.spec import SceneSet
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -48,8 +49,20 @@ def test_fitting_brings_the_mode_to_the_teachers_labels_on_states_never_fitted()
     actor, _ = make_sac_agent(env, NetworkConfig(channels=4, hidden=16, location_hidden=8))
     label = [0.5, -0.5, 0.25]
     data, held = torch.stack(states(32, label)), torch.stack(states(8, label))
-    before = module.mode_error(actor, held).item()
+    before = mode_distance(actor, held).item()
     passes = module.fit(actor, torch.optim.Adam(actor.parameters(), lr=1e-2), data, held, 30, 8,
                         torch.Generator().manual_seed(0))
     assert len(passes) == 30 and passes[-1]["train"] < passes[0]["train"]
     assert passes[-1]["held"] < 0.05 < before
+
+
+def test_its_training_config_is_nbv_trains_for_the_same_preset_and_buildings(tmp_path):
+    from common.provenance import config_record
+    from nbv.cli.train import parse_train
+
+    scenes = ["medieval_tavern", "family:22", "random:9"]
+    flags = [arg for scene in scenes for arg in ("--scene", scene)]
+    made = dagger().train_config("default", scenes, tmp_path)
+    assert config_record(made) == config_record(parse_train([*flags, "--out", str(tmp_path)]))
+    assert config_record(dagger().train_config("paper", [], tmp_path)) == config_record(
+        parse_train(["--preset", "paper", "--out", str(tmp_path)]))

@@ -74,6 +74,22 @@ def buffer_states(path: Path, keys: list[str], last: int) -> list[TensorDict]:
     return [TensorDict({k: item[k] for k in keys}, []) for item in stored[-last if last else 0:]]
 
 
+def seed_states(buffers: list[Path], keys: list[str], share: float,
+                generator: torch.Generator) -> tuple[list[TensorDict], TensorDict | None]:
+    """The labelled states of the `buffers` (each `CHECKPOINT[:LAST]`), shuffled, less a `share` of them
+    held aside (stacked; None when none is)."""
+    pooled: list[TensorDict] = []
+    for spec in buffers:
+        path, _, last = str(spec).partition(":")
+        pooled += buffer_states(Path(path), keys, int(last or 0))
+    if not pooled:
+        return pooled, None
+    order = torch.randperm(len(pooled), generator=generator).tolist()
+    cut = int(round(share * len(pooled)))
+    held = torch.stack([pooled[i] for i in order[:cut]]) if cut else None
+    return [pooled[i] for i in order[cut:]], held
+
+
 def train_config(preset: str, scenes: list[str], out: Path) -> TrainConfig:
     """`nbv train --preset PRESET [--scene S ...] --out OUT`'s config (the given scenes replace the
     preset's), built from the presets themselves: a script does not import the command line."""
@@ -130,18 +146,11 @@ def main(argv: list[str]) -> int:
     optimiser = torch.optim.Adam(actor.parameters(), lr=args.lr)
     generator = torch.Generator().manual_seed(args.seed)
     keys = [*actor.in_keys, EXPERT_KEY]
-    pooled: list[TensorDict] = []
-    for spec in args.buffers:
-        path, _, last = str(spec).partition(":")
-        pooled += buffer_states(Path(path), keys, int(last or 0))
-    held = None
+    pooled, held = seed_states(args.buffers, keys, args.held, generator)
     log = []
     start = time.perf_counter()
     if pooled:
-        order = torch.randperm(len(pooled), generator=generator).tolist()
-        cut = int(round(args.held * len(pooled)))
-        held = torch.stack([pooled[i] for i in order[:cut]]) if cut else None
-        pooled = [pooled[i] for i in order[cut:]]
+        cut = 0 if held is None else len(held)
         log.append({"iteration": "buffers", "states": len(pooled), "held_states": cut,
                     "passes": fit(actor, optimiser, torch.stack(pooled), held, args.epochs, args.batch,
                                   generator), "seconds": round(time.perf_counter() - start, 1)})

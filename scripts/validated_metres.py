@@ -21,7 +21,7 @@ from common.io import write_json
 from common.provenance import config_from_record, git_commit, portable_record
 from nbv.rl.checkpoint import load_policy
 from nbv.rl.config import TrainConfig
-from nbv.rl.validate import LatticeValidator
+from nbv.rl.validate import Validator, mean_score
 
 
 def main(argv: list[str]) -> int:
@@ -32,18 +32,19 @@ def main(argv: list[str]) -> int:
     args = parser.parse_args(argv)
     config = config_from_record(TrainConfig, json.loads((args.run / "config.json").read_text()))
     config = replace(config, validation=replace(config.validation, validation_exact=args.exact))
-    validator = LatticeValidator(config.env, config.validation, config.network)
+    validator = Validator(config.env, config.validation, config.network)
     actors = sorted(args.run.glob("**/validated/policy_*.pt"))
     if not actors:
         raise SystemExit(f"no kept actors under {args.run} (train with --validation-keep)")
     scored = {}
     for path in tqdm(actors, unit="actor"):
         scores, metres = validator.score_and_metres(load_policy(path)[1])
-        score = sum(scores.values()) / len(scores)
+        score = mean_score(scores)
         scored[str(path.relative_to(args.run))] = [round(score, 3), round(metres, 3)]
     command = ["scripts/validated_metres.py", *argv]
-    write_json(args.out, portable_record({"commit": git_commit(), "command": command,
-                                          "fields": ["lattice score %", "metres"], "actors": scored}))
+    fields = [f"{'exact' if args.exact else 'lattice'} score %", "metres"]
+    write_json(args.out, portable_record({"commit": git_commit(), "command": command, "fields": fields,
+                                          "actors": scored}))
     return 0
 
 

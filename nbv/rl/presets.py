@@ -1,10 +1,11 @@
 """Named starting points of `nbv train` (`--preset NAME`); every flag still overrides them.
 
 - `default`: what issue 26's selection rounds chose on validation buildings (paper_results/selection,
-  rounds 5 to 11): `looks` with the look map (`EnvConfig.look_map`), orbit actions (an azimuth step of up
+  rounds 5 to 17): `looks` with the look map (`EnvConfig.look_map`), orbit actions (an azimuth step of up
   to 60 degrees, absolute radius and elevation), a flight-cost term (`FLIGHT_REWARD`) and an imitation
   term pulling the actor towards the privileged teacher (`IMITATION`), trained on `DEFAULT_TRAIN_SCENES`;
-  `MEMBERS` training seeds, the best-validated actor of them all kept as `policy.pt`.
+  `MEMBERS` training seeds, validated on exact renders (round 17), the best-validated actor within
+  `VALIDATION_MAX_METRES` of them all kept as `policy.pt`, every validated actor kept beside it.
 - `coverage`: the default until issue 26 (issue 11, paper_results/selection rounds 1 to 4): the paper's
   networks and SAC on a view lattice at 160x120, 4 spp, OpenCV SIFT, with relative actions (steps up to
   1/8 of each range), rewards scaled by 0.1, Bag of Views ranges split into 2 elevation bands, a coverage
@@ -62,10 +63,19 @@ FAMILY_VALIDATION_SCENES = ("family:4",)
 """A validation-split `family:SEED` building (SEED % 5 == 4), a tower: one, for the lattice's cost."""
 COVERAGE_MEMBERS = 3
 """Training seeds of one `coverage` command, side by side (three 6000-frame runs: 11-15 min on 2 cores)."""
-DEFAULT_TRAIN_SCENES = (*TRAIN_SCENES, *FAMILY_TRAIN_SCENES, "family:3", "family:11", "family:12",
-                        "family:18")
-"""The default's 14 training buildings (round 8 of paper_results/selection): `looks`' ten, a U plan
-(`family:3`) and a second tower, courtyard and hall (`family:11`, `12`, `18`)."""
+ROUND8_TRAIN_SCENES = (*TRAIN_SCENES, *FAMILY_TRAIN_SCENES, "family:3", "family:11", "family:12",
+                       "family:18")
+"""The default's 14 training buildings from round 8 to round 14 of paper_results/selection: `looks`' ten, a
+U plan (`family:3`) and a second tower, courtyard and hall (`family:11`, `12`, `18`)."""
+DEFAULT_TRAIN_SCENES = (*ROUND8_TRAIN_SCENES, "family:6", "family:13", "family:16", "family:17", "family:21",
+                        "family:22", "family:23", "family:26", "family:27", "family:28",
+                        "random:9", "random:11", "random:12", "random:13")
+"""The default's 28 training buildings (rounds 15 and 17 of paper_results/selection: twice the buildings gave
+the best students of four seeds): round 8's 14, ten more training-split family buildings and four more
+training-split random buildings."""
+VALIDATION_MAX_METRES = 13.1
+"""The default's metres bar on validation flights: 1.5x the tuned ring's 8.76 m on the validation buildings
+(issue 26's metres check; round 17's `exact_metres.json`)."""
 ORBIT_STEP = 0.16666667
 """The default's largest azimuth step, as a share of the range: 60 degrees (round 9: steps of 1/8 cannot fly
 the teacher's path). Written to 8 decimals, as the selection rounds' command lines gave it."""
@@ -74,7 +84,7 @@ FLIGHT_REWARD = 0.2
 IMITATION = 1000.0
 """The default's weight of the imitation term (rounds 8, 10 and 11)."""
 MEMBERS = 2
-"""Training seeds of one default command, side by side (two 6000-frame runs: 32 min on 2 cores)."""
+"""Training seeds of one default command, side by side (two 6000-frame runs: 28 min on 2 cores)."""
 
 
 def paper_preset() -> TrainConfig:
@@ -114,8 +124,11 @@ def default_preset() -> TrainConfig:
     env = replace(looks.env, scenes=SceneSet(scene=DEFAULT_TRAIN_SCENES), look_map=True, action_mode="orbit",
                   relative_step=ORBIT_STEP)
     reward = replace(looks.reward, flight=FLIGHT_REWARD, imitation=IMITATION)
+    validation = replace(looks.validation, validation_max_metres=VALIDATION_MAX_METRES, validation_exact=True,
+                         validation_keep=True)
     return replace(looks, env=env, reward=reward, logger=replace(looks.logger, checkpoint_every=500),
-                   members=MembersConfig(count=MEMBERS), executor=ExecutorConfig(workers=MEMBERS))
+                   validation=validation, members=MembersConfig(count=MEMBERS),
+                   executor=ExecutorConfig(workers=MEMBERS))
 
 
 PRESETS = {"default": default_preset, "paper": paper_preset, "coverage": coverage_preset,

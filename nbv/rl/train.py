@@ -70,7 +70,7 @@ from nbv.rl.config import OptimConfig, TrainConfig, upgrade_record
 from nbv.rl.env import NBVEnv
 from nbv.rl.expert import EXPERT_KEY
 from nbv.rl.run_logs import trim_log, validation_fields
-from nbv.rl.validate import LatticeValidator
+from nbv.rl.validate import Validator, mean_score
 from nbv.viz.figures import plot_training_curves
 
 CHECKPOINT = "checkpoint.pt"
@@ -137,7 +137,7 @@ def train_run(config: TrainConfig) -> Path:
         return run / CHECKPOINT  # the budget is already spent: nothing to do
     validator = None
     if config.validation.enabled:
-        validator = LatticeValidator(config.env, config.validation, config.network)
+        validator = Validator(config.env, config.validation, config.network)
     best = resumed.get("validation") if resumed is not None else None  # {"frames", "score"} so far
 
     # Environment and collector (random actions until init_random_frames).
@@ -287,7 +287,7 @@ class RunLog:
 
 
 def checkpoint_run(run: Path, config: TrainConfig, learner: Learner, frames: int, updates: int,
-                   env: NBVEnv | None, validator: LatticeValidator | None, best: dict | None,
+                   env: NBVEnv | None, validator: Validator | None, best: dict | None,
                    log: RunLog) -> dict | None:
     """Validate the actor (with validation buildings), draw the curves and write the checkpoint (and the
     policy file); return the best validation {"frames", "score"} so far."""
@@ -342,7 +342,7 @@ def validated_policy(run: Path, frames: int) -> Path:
     return run / VALIDATED / f"policy_{frames:06d}.pt"
 
 
-def validate_checkpoint(validator: LatticeValidator, run: Path, config: TrainConfig, loss_state: dict,
+def validate_checkpoint(validator: Validator, run: Path, config: TrainConfig, loss_state: dict,
                         counters: dict[str, int], best: dict | None) -> dict:
     """Score the actor on the validation buildings, log the row, and write `policy.pt` when it is the best
     so far (`ValidationConfig.rank`: within the metres bar, then score; ties keep the earlier actor);
@@ -351,7 +351,7 @@ def validate_checkpoint(validator: LatticeValidator, run: Path, config: TrainCon
     state = rng_state()
     scores, metres = validator.score_and_metres(actor_weights(loss_state))
     set_rng_state(state)
-    score = float(sum(scores.values()) / len(scores))
+    score = mean_score(scores)
     rank, record = config.validation.rank, json.dumps(config_record(config))
     if config.validation.validation_keep:
         kept = validated_policy(run, counters["frames"])

@@ -4,10 +4,12 @@ Training return measures the Bag of Views reward, not the reconstruction, and it
 start views and buildings of the episodes that happen to be sampled; the last actor of a run is not
 its best (docs/rl.md §11). So `nbv train` with validation buildings scores the actor at every
 checkpoint: from the same seeded start views on each validation building, its mode flies a fixed
-number of views on the building's view lattice (the training cache, so no view is rendered again),
-and the score is the share of the true surface those views see (`nbv.recon.visibility`, a ray-cast
-depth test at each view's exact pose). `policy.pt` keeps the best-scoring actor. The policy sees the
-nearest nodes' frames as in training; evaluation (`nbv plan`, `nbv online`) renders exact viewpoints.
+number of views on the building's view lattice (the training cache, so no view is rendered again) or,
+with `validation_exact`, on exact renders as evaluation flies them, and the score is the share of the
+true surface those views see (`nbv.recon.visibility`, a ray-cast depth test at each view's exact pose).
+`policy.pt` keeps the best-scoring actor (within the metres bar first, `ValidationConfig.rank`). On the
+lattice the policy sees the nearest nodes' frames as in training, which moves its actions: evaluation
+(`nbv plan`, `nbv online`) renders exact viewpoints, as exact validation does.
 
 `evaluation_env_config` is the one recipe of an env that evaluates a trained policy's settings (exact
 renders, no lattice; no training-only reward term, which lives in `TrainConfig.reward`, not in the env):
@@ -50,8 +52,14 @@ def evaluation_env_config(trained: EnvConfig, scenes: SceneSet, render: RenderSe
                    **{key: value for key, value in changes.items() if value is not None})
 
 
-class LatticeValidator:
-    """Scores actor weights on the validation buildings (mean visible coverage, %, per building).
+def mean_score(scores: dict[str, float]) -> float:
+    """An actor's validation score: the mean over the buildings of `Validator.score`'s coverages (%)."""
+    return float(sum(scores.values()) / len(scores))
+
+
+class Validator:
+    """Scores actor weights on the validation buildings (mean visible coverage, %, per building), on their
+    view lattices or on exact renders (`ValidationConfig.validation_exact`).
 
     Args:
         env: the training env config (its camera, lattice, action mode and Bag of Views are used).

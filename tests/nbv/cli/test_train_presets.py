@@ -33,8 +33,11 @@ def test_default_is_the_looks_preset_with_the_chosen_additions():
     assert default.env.bov_observation and default.env.look_map and not looks.env.look_map
     assert (default.env.action_mode, default.env.relative_step) == ("orbit", 0.16666667)
     assert (default.reward.coverage, default.reward.flight, default.reward.imitation) == (100.0, 0.2, 1000.0)
-    assert len(default.env.scenes.scene) == 14 and default.members.count == default.executor.workers == 2
+    assert len(default.env.scenes.scene) == 28 and default.members.count == default.executor.workers == 2
+    assert set(looks.env.scenes.scene) < set(default.env.scenes.scene)
     assert default.validation.validation_scenes == looks.validation.validation_scenes
+    assert default.validation.validation_exact and default.validation.validation_keep  # exact renders
+    assert default.validation.validation_max_metres == 13.1 and looks.validation.validation_max_metres == 0
     coverage = parsed(["--preset", "coverage", "--out", "run"])
     assert coverage.env.scenes.scene == TRAIN_SCENES and not coverage.env.bov_observation
     assert (coverage.env.action_mode, coverage.reward.flight, coverage.members.count) == ("relative", 0.0, 3)

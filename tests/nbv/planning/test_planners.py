@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import replace
+from pathlib import Path
 
 import pytest
 import torch
@@ -172,6 +173,13 @@ def test_policy_file_plans_like_its_checkpoint(tmp_path):
     assert from_file == same
 
 
+def test_shipped_policy_is_the_actor_the_validation_checks_chose():
+    round17 = Path(__file__).resolve().parents[3] / "paper_results" / "selection" / "round17"
+    chosen = PolicyPlanner(round17 / "policies" / "s3f6000.pt").actor.state_dict()
+    shipped = PolicyPlanner(SHIPPED_POLICY).actor.state_dict()  # nbv/planning/shipped/README.md: bit for bit
+    assert chosen.keys() == shipped.keys() and all(torch.equal(chosen[k], shipped[k]) for k in chosen)
+
+
 def test_bare_policy_spec_is_the_shipped_policy():
     assert split_spec("policy") == (entry("policy"), None)  # no checkpoint: the factory takes the shipped one
     assert split_spec("policy-sample:run/policy.pt") == (entry("policy-sample"), "run/policy.pt")
@@ -183,7 +191,7 @@ def test_bare_policy_spec_is_the_shipped_policy():
 
 
 @pytest.mark.parametrize("path, command", [
-    (SHIPPED_POLICY, ["--out", "runs/default"]),  # nbv/planning/shipped/README.md
+    (SHIPPED_POLICY, ["--seed", "1", "--out", "runs/default"]),  # nbv/planning/shipped/README.md
     (SHIPPED_POLICY.parent / "coverage" / "policy.pt", ["--preset", "coverage", "--out", "runs/default"]),
 ])
 def test_shipped_policy_is_its_training_command_and_plans(path, command):

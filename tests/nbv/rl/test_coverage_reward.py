@@ -21,7 +21,7 @@ from nbv.rl.agent import make_actor
 from nbv.rl.builders import make_environment, make_sac_agent
 from nbv.rl.config import EnvConfig, LatticeConfig, NetworkConfig, RewardConfig, ValidationConfig
 from nbv.rl.env import NBVEnv
-from nbv.rl.validate import LatticeValidator, evaluation_env_config, validation_env_config
+from nbv.rl.validate import Validator, evaluation_env_config, validation_env_config
 from render.camera import UAVCamera
 from render.settings import RenderSettings
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
@@ -136,7 +136,7 @@ def test_the_validator_scores_on_the_true_mesh_but_its_envs_have_no_term(tmp_pat
     grid = LatticeConfig(lattice_radii=1, lattice_azimuths=4, lattice_elevations=2)
     validation = ValidationConfig(validation_scenes=("test_building",), validation_episodes=1,
                                   validation_views=2, validation_points=500)
-    validator = LatticeValidator(config(lattice=grid), validation, NetworkConfig())
+    validator = Validator(config(lattice=grid), validation, NetworkConfig())
     validator.score(make_actor(5, 16, NetworkConfig()).state_dict())
     assert [env.reward_terms for env in validator._envs.values()] == [RewardConfig()]
     assert validation_env_config(config(lattice=grid), validation).lattice.enabled

@@ -4,6 +4,7 @@ the evaluation env (the model-selection score itself: tests/nbv/planning/test_se
 from __future__ import annotations
 
 import csv
+import json
 from dataclasses import replace
 
 import numpy as np
@@ -18,10 +19,11 @@ from nbv.rl.config import LatticeConfig, ValidationConfig
 from nbv.rl.env import NBVEnv
 from nbv.rl.rollout import policy_views
 from nbv.rl.train import train_run
-from nbv.rl.validate import LatticeValidator, evaluation_env_config, validation_env_config
+from nbv.rl.validate import Validator, evaluation_env_config, validation_env_config
 from render.settings import RenderSettings
 from render.viewpoint import viewpoint_to_c2w
 from scenes.spec import SceneSet
+from scripts.validated_metres import main as validated_metres
 from tests.nbv.rl.test_train import tiny
 
 SMALL_LATTICE = LatticeConfig(lattice_radii=1, lattice_azimuths=4, lattice_elevations=2)
@@ -46,7 +48,7 @@ def test_score_is_the_visible_coverage_of_the_modes_views(tmp_path, cache, exact
     validation = replace(VALIDATION, validation_exact=exact)  # exact: rendered, not the lattice's frames
     actor = make_actor(config.env.history, config.env.obs_size, config.network)
     weights = actor.state_dict()
-    scores, metres = LatticeValidator(config.env, validation, config.network).score_and_metres(weights)
+    scores, metres = Validator(config.env, validation, config.network).score_and_metres(weights)
 
     env_config = validation_env_config(config.env, validation)
     assert env_config.lattice.enabled == (not exact) and env_config.scenes.scene == ("test_building",)
@@ -88,7 +90,7 @@ def test_validated_training_keeps_the_best_policy_and_trains_as_without(tmp_path
     policy = torch.load(tmp_path / "run" / "policy.pt", weights_only=True)
     assert policy["counters"]["frames"] == 2 * (best + 1)
     config = validated(tmp_path, 6)
-    validator = LatticeValidator(config.env, VALIDATION, config.network)
+    validator = Validator(config.env, VALIDATION, config.network)
     scores, metres = validator.score_and_metres(weights)
     assert scores["test_building"] == pytest.approx(means[best], abs=1e-3)
     assert float(rows[best]["metres"]) == pytest.approx(metres, abs=1e-3) and metres > 0  # flown, logged
@@ -98,6 +100,14 @@ def test_validated_training_keeps_the_best_policy_and_trains_as_without(tmp_path
         assert validator.score(load_policy(tmp_path / "run" / "validated" / name)[1])["test_building"] == \
             pytest.approx(mean, abs=1e-3)
     assert not (tmp_path / "plain" / "validated").exists()
+    out = tmp_path / "metres.json"  # scripts/validated_metres.py flies every kept actor again, as logged
+    assert validated_metres(["--run", str(tmp_path / "run"), "--out", str(out)]) == 0
+    record = json.loads(out.read_text())
+    assert record["fields"] == ["lattice score %", "metres"] and sorted(record["actors"]) == \
+        [f"validated/{name}" for name in kept]
+    for (score, flown), row in zip((record["actors"][f"validated/{name}"] for name in kept), rows):
+        assert score == pytest.approx(float(row["mean"]), abs=1e-3)
+        assert flown == pytest.approx(float(row["metres"]), abs=1e-3)
 
 
 def test_actors_within_the_metres_bar_are_kept_first_then_the_best_score():

@@ -29,7 +29,7 @@ import numpy as np
 from tyro.conf import arg
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
-from common.provenance import config_record, git_commit, run_cache
+from common.provenance import config_record, git_commit, portable_record, run_cache
 from nbv.experiments.budget_flight import METRES, flight_markdown, flight_tables, seed_rows
 from nbv.experiments.planner_study import PlannerStudy, StudyRun, run_study
 from nbv.experiments.sfm_columns import planned_sfm_table
@@ -130,7 +130,7 @@ def run_budget(config: BudgetConfig) -> dict[str, list[dict[str, Any]]]:
     curves = {measure: study_curves(runs, measure) for measure, _ in MEASURES}
     rows = {measure: budget_rows(curves[measure], config.budgets) for measure, _ in MEASURES}
     flight = flight_tables(runs, curves["coverage"], config.metres)
-    record = config_record(config, omit=("executor",))
+    record = portable_record(config_record(config, omit=("executor",)))
     with atomic_folder(config.out, overwrite=True, outputs=OUTPUTS) as out:
         write_text(out / "budget.md", budget_markdown(rows, config)
                    + flight_markdown(flight, config.budgets, config.metres) + budget_sfm(runs, config))

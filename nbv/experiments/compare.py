@@ -30,7 +30,7 @@ import numpy as np
 from tyro.conf import arg
 
 from common.io import atomic_folder, write_json, write_text
-from common.provenance import config_record, git_commit
+from common.provenance import config_record, git_commit, portable_record
 from nbv.experiments.paper_numbers import FIG1_NBV
 from nbv.experiments.planner_study import PlannerStudy, plan_units, reference_units, run_study
 from nbv.experiments.sfm_columns import SFM_HEADER, sfm_cells, sfm_entry
@@ -123,7 +123,7 @@ def compare_planners(config: CompareConfig) -> str:
                      **prefix_flight(doc), **({"sfm": sfm_entry(doc["sfm"])} if config.sfm else {})})
     scene = config.scene.scene
     table = comparison_table(runs, scene, config.settings.metrics.threshold_cm)
-    record = config_record(config, omit=("executor",))
+    record = portable_record(config_record(config, omit=("executor",)))
     with atomic_folder(Path(config.out), overwrite=True, outputs=OUTPUTS) as folder:
         write_text(folder / "comparison.md", table)
         plot_planner_comparison(runs, FIG1_NBV, folder / "comparison.png",

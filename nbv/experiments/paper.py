@@ -23,7 +23,7 @@ import numpy as np
 from tyro.conf import UseAppendAction
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
-from common.provenance import config_record, git_commit, run_cache
+from common.provenance import config_record, git_commit, portable_record, run_cache
 from nbv.bov.config import BoVRule
 from nbv.bov.refine import Progress
 from nbv.experiments.budget import BUDGETS, SETTINGS, BudgetConfig, run_budget
@@ -171,7 +171,7 @@ def run_episodes(config: PaperConfig) -> list[dict[str, Any]]:
     with atomic_folder(config.out, overwrite=True, outputs=EPISODE_OUTPUTS) as out:
         write_text(out / "fig1_fig7.md", episodes_markdown(rows, config))
         plot_episodes(rows, out / "fig1_fig7.png")
-        record = config_record(config, omit=("executor",))
+        record = portable_record(config_record(config, omit=("executor",)))
         write_json(out / "fig1_fig7.json", {"commit": git_commit(), "config": record, "rows": rows})
     return rows
 

@@ -30,7 +30,7 @@ import numpy as np
 from tyro.conf import Suppress
 
 from common.io import atomic_folder, markdown_table, scratch_folder, write_json, write_text
-from common.provenance import config_record, git_commit
+from common.provenance import config_record, git_commit, portable_record
 from nbv.bov.config import BoVRule
 from nbv.bov.refine import DatasetRun, Progress, kept_view_grid, load_views
 from nbv.bov.sweep import PAPER_RANGES, PAPER_WORDS, write_csv
@@ -177,7 +177,7 @@ def run_tables(config: TablesConfig, progress: Progress | None = None) -> list[d
             for image in sorted((unit.result.parent / "fig6").iterdir()):
                 image.rename(fig6 / image.name)
         rows = mean_rows(seed_rows)
-        record = config_record(config, omit=("executor",))
+        record = portable_record(config_record(config, omit=("executor",)))
         header = {"command": f"make tables  (nbv tables --out {out})", "commit": git_commit(),
                   "seconds": round(time.perf_counter() - start, 1), "config": record}
         with atomic_folder(out, overwrite=True, outputs=OUTPUTS) as folder:

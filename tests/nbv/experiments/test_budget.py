@@ -42,6 +42,7 @@ def test_a_sequential_plans_prefix_scores_as_its_shorter_plan(tmp_path):
         assert all(0 < m <= 100 for r in rows[measure] for m in r["mean"])
     doc = json.loads((tmp_path / "out" / "budget.json").read_text())
     assert set(doc["curves"]["visible"]) == {"test_building/greedy", "test_building/circle"}
+    assert doc["config"]["out"] == f"ELSEWHERE/{tmp_path.name}/out"  # no machine's folders in the record
     table = (tmp_path / "out" / "budget.md").read_text()
     assert "| test_building | greedy |" in table and "| 2 views | 3 views | AUC |" in table
     with Image.open(tmp_path / "out" / "budget.png") as image:

@@ -36,6 +36,7 @@ def test_compare_planners_tabulates_saved_runs(tmp_path):
     saved = json.loads((tmp_path / "comparison.json").read_text())
     assert [r["seed"] for r in saved["runs"]] == [0, 1] and saved["paper_fig1"]["coverage"] == 0.946
     assert saved["config"]["scene"] == {"up_axis": "z", "scene": "alpine_chalet"}
+    assert saved["config"]["out"] == f"ELSEWHERE/{tmp_path.parent.name}/{tmp_path.name}"  # portable
     assert (tmp_path / "comparison.md").read_text() == table
     assert Image.open(tmp_path / "comparison.png").size[0] > 500
 

@@ -71,4 +71,5 @@ def test_tables_on_local_workers_give_the_rows_measured_in_process(tmp_path):
     assert there == here and ticks == [2]  # the building's two rows, once it is done
     docs = [json.loads((tmp_path / out / "table2.json").read_text()) for out in ("here", "there")]
     assert docs[0]["rows"] == docs[1]["rows"] and "executor" not in docs[1]["config"]
+    assert docs[1]["config"]["out"] == f"ELSEWHERE/{tmp_path.name}/there"  # no machine's folders
     assert [p.name for p in (tmp_path / "there" / "fig6").glob("*.png")] == ["fig6_test_building_N3_W5.png"]

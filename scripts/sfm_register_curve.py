@@ -45,7 +45,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from common.io import cache_dir, markdown_table, write_json, write_text  # noqa: E402
-from common.provenance import git_commit  # noqa: E402
+from common.provenance import git_commit, portable_text  # noqa: E402
 from nbv.experiments.planner_study import planner_settings  # noqa: E402
 from nbv.planning.config import PlanConfig, PlanSettings  # noqa: E402
 from nbv.planning.plan import choose_views, planning_env_config  # noqa: E402
@@ -216,7 +216,7 @@ def main(argv: list[str]) -> int:
         doc = json.loads((args.out / "register_curve.json").read_text())
         write_outputs(args, doc["cases"], doc["command"], doc["commit"])
         return 0
-    command = "python scripts/sfm_register_curve.py " + " ".join(argv)
+    command = portable_text("python scripts/sfm_register_curve.py " + " ".join(argv))  # no machine paths
     commit = git_commit()
     for planner in args.planners:  # each factory imported now, as at `commit`
         make_planner(planner, PlanSettings(full_scan=False), args.seed)

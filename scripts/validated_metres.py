@@ -1,5 +1,6 @@
 """Every kept actor of a run (`nbv train --validation-keep`) scored again as its validation scored it:
-lattice coverage (%) and metres flown per episode (issue 26, round 17), or with `--exact` on exact renders.
+coverage (%) and metres flown per episode, on the view lattices or exact renders as the run validated
+(issue 26, round 17), or with `--exact` on exact renders whatever the run did.
 
 Written to OUT as JSON: per member folder and actor file, [mean score, metres]. The validation settings
 are the run's own (its config.json):
@@ -28,10 +29,12 @@ def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--run", type=Path, required=True)
     parser.add_argument("--out", type=Path, required=True)
-    parser.add_argument("--exact", action="store_true", help="fly exact renders, not the view lattices")
+    parser.add_argument("--exact", action="store_true",
+                        help="fly exact renders even if the run validated on the view lattices")
     args = parser.parse_args(argv)
     config = config_from_record(TrainConfig, json.loads((args.run / "config.json").read_text()))
-    config = replace(config, validation=replace(config.validation, validation_exact=args.exact))
+    exact = args.exact or config.validation.validation_exact  # by default as the run's validation flew
+    config = replace(config, validation=replace(config.validation, validation_exact=exact))
     validator = Validator(config.env, config.validation, config.network)
     actors = sorted(args.run.glob("**/validated/policy_*.pt"))
     if not actors:
@@ -42,7 +45,7 @@ def main(argv: list[str]) -> int:
         score = mean_score(scores)
         scored[str(path.relative_to(args.run))] = [round(score, 3), round(metres, 3)]
     command = ["scripts/validated_metres.py", *argv]
-    fields = [f"{'exact' if args.exact else 'lattice'} score %", "metres"]
+    fields = [f"{'exact' if exact else 'lattice'} score %", "metres"]
     write_json(args.out, portable_record({"commit": git_commit(), "command": command, "fields": fields,
                                           "actors": scored}))
     return 0

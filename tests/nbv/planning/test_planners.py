@@ -173,11 +173,16 @@ def test_policy_file_plans_like_its_checkpoint(tmp_path):
     assert from_file == same
 
 
+def same_weights(a: PolicyPlanner, b: PolicyPlanner) -> bool:
+    """Whether two policy planners' actors hold the same tensors, bit for bit."""
+    first, second = a.actor.state_dict(), b.actor.state_dict()
+    return first.keys() == second.keys() and all(torch.equal(first[k], second[k]) for k in first)
+
+
 def test_shipped_policy_is_the_actor_the_validation_checks_chose():
     round17 = Path(__file__).resolve().parents[3] / "paper_results" / "selection" / "round17"
-    chosen = PolicyPlanner(round17 / "policies" / "s3f6000.pt").actor.state_dict()
-    shipped = PolicyPlanner(SHIPPED_POLICY).actor.state_dict()  # nbv/planning/shipped/README.md: bit for bit
-    assert chosen.keys() == shipped.keys() and all(torch.equal(chosen[k], shipped[k]) for k in chosen)
+    chosen = PolicyPlanner(round17 / "policies" / "s3f6000.pt")
+    assert same_weights(chosen, PolicyPlanner(SHIPPED_POLICY))  # nbv/planning/shipped/README.md: bit for bit
 
 
 def test_bare_policy_spec_is_the_shipped_policy():
@@ -185,9 +190,7 @@ def test_bare_policy_spec_is_the_shipped_policy():
     assert split_spec("policy-sample:run/policy.pt") == (entry("policy-sample"), "run/policy.pt")
     assert split_spec("random") == (entry("random"), None) and not entry("random").checkpoint
     assert planner_label("policy") == "policy-shipped"
-    made = make_planner("policy", PLAN).actor.state_dict()
-    shipped = PolicyPlanner(SHIPPED_POLICY).actor.state_dict()
-    assert made.keys() == shipped.keys() and all(torch.equal(made[k], shipped[k]) for k in made)
+    assert same_weights(make_planner("policy", PLAN), PolicyPlanner(SHIPPED_POLICY))
 
 
 @pytest.mark.parametrize("path, command", [

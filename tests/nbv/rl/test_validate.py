@@ -108,6 +108,16 @@ def test_validated_training_keeps_the_best_policy_and_trains_as_without(tmp_path
     for (score, flown), row in zip((record["actors"][f"validated/{name}"] for name in kept), rows):
         assert score == pytest.approx(float(row["mean"]), abs=1e-3)
         assert flown == pytest.approx(float(row["metres"]), abs=1e-3)
+    run_config = tmp_path / "run" / "config.json"  # a run validated on exact renders is rescored on them
+    recorded = json.loads(run_config.read_text())
+    recorded["validation"]["validation_exact"] = True
+    run_config.write_text(json.dumps(recorded))
+    assert validated_metres(["--run", str(tmp_path / "run"), "--out", str(out)]) == 0
+    record = json.loads(out.read_text())
+    exact = Validator(config.env, replace(VALIDATION, validation_exact=True), config.network)
+    assert record["fields"] == ["exact score %", "metres"]
+    assert record["actors"][f"validated/{kept[0]}"][0] == pytest.approx(
+        exact.score(load_policy(tmp_path / "run" / "validated" / kept[0])[1])["test_building"], abs=1e-3)
 
 
 def test_actors_within_the_metres_bar_are_kept_first_then_the_best_score():

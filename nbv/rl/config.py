@@ -345,11 +345,17 @@ class RewardConfig:
     teacher_discount: Annotated[float, arg(name="teacher-discount")] = 0.9
     """The weight, per step ahead, of a later view's new samples and leg against the next view's."""
 
+    teacher_tolerance: Annotated[float, arg(name="teacher-tolerance")] = 0.0
+    """Coverage points within which the teacher's candidate steps count as ties (`nbv.rl.expert.near_best`):
+    the imitation term pulls the actor's mode to the nearest of them. 0: to the teacher's one best step."""
+
     def __post_init__(self) -> None:
         if self.teacher_horizon < 0:
             raise ValueError(f"teacher_horizon must be >= 0, got {self.teacher_horizon}")
         if not 0 < self.teacher_discount <= 1:
             raise ValueError(f"teacher_discount must lie in (0, 1], got {self.teacher_discount}")
+        if not 0 <= self.teacher_tolerance < math.inf:
+            raise ValueError(f"teacher_tolerance must be finite and >= 0, got {self.teacher_tolerance}")
         if not 0 <= self.imitation < math.inf:
             raise ValueError(f"imitation must be finite and >= 0, got {self.imitation}")
         if not 0 <= self.coverage < math.inf:

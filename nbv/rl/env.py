@@ -33,8 +33,9 @@ reward adds W x the share of the target's surface samples
 (`nbv.recon.visibility`) that the new view is the episode's first to see; on
 a lattice that is the node's view, as the frame is. With an imitation weight
 > 0 (`RewardConfig.imitation`) every state also holds the privileged teacher's
-action (`expert_action`, `nbv.rl.expert`), which the actor never reads: the
-SAC update pulls the actor's mode towards it.
+action (`expert_action`, `nbv.rl.expert`), and with a `teacher_tolerance` its
+near-ties (`expert_near_best`), which the actor never reads: the SAC update
+pulls the actor's mode towards them.
 
 Termination: one pass around the target, i.e. the net azimuth travelled
 (each step's change wrapped to (-pi, pi]) reaches 2 pi in either direction;
@@ -82,7 +83,7 @@ from nbv.recon.visibility import SurfaceVisibility, scene_visibility
 from nbv.rl.bov_observation import BOV_KEY, bov_observation_size, bov_vector, novelty_of
 from nbv.rl.config import EnvConfig, RewardConfig
 from nbv.rl.episode_return import RETURN_KEY
-from nbv.rl.expert import EXPERT_KEY, expert_action
+from nbv.rl.expert import CANDIDATES, EXPERT_KEY, EXPERT_SET_KEY, best_action, expert_scores, near_best
 from nbv.rl.lattice import ViewLattice, build_lattice
 from nbv.rl.look_map import look_of
 from render.viewpoint import TWO_PI, Viewpoint, draw_viewpoint, viewpoint_to_c2w
@@ -177,6 +178,8 @@ class NBVEnv(EnvBase):
                  } if config.bov_observation else {}
         if reward_terms.imitation:
             extra[EXPERT_KEY] = Bounded(-1.0, 1.0, shape=(3,), dtype=torch.float32)
+        if reward_terms.imitation and reward_terms.teacher_tolerance:
+            extra[EXPERT_SET_KEY] = Categorical(2, shape=(len(CANDIDATES),), dtype=torch.bool)
         self.observation_spec = Composite(
             pixels=Bounded(0, 255, shape=(tau, side, side), dtype=torch.uint8),
             viewpoints=Bounded(-1.0, 1.0, shape=(tau, 3), dtype=torch.float32),
@@ -396,14 +399,24 @@ class NBVEnv(EnvBase):
             self._node_seen[scene, index] = seen
         return self._node_seen[scene, index]
 
-    def expert_action(self) -> np.ndarray:
-        """The privileged teacher's action from the current view (`nbv.rl.expert`): it reads the true
-        surface, so training envs with an imitation term alone call it."""
+    def expert_scores(self) -> np.ndarray:
+        """The privileged teacher's scores of its candidate steps from the current view (`nbv.rl.expert`):
+        it reads the true surface, so training envs with an imitation term alone call it."""
         step = lambda action, view: action_to_viewpoint(action, view, self.config)  # noqa: E731
         views_left = (self.config.episode_views or self.config.max_steps + 1) - self._steps - 1
         terms = self.reward_terms
-        return expert_action(self._view, self._seen, self.surface_seen, step, terms.flight, views_left,
+        return expert_scores(self._view, self._seen, self.surface_seen, step, terms.flight, views_left,
                              terms.teacher_horizon, terms.teacher_discount)
+
+    def _teacher(self) -> dict[str, torch.Tensor]:
+        """The state's teacher labels: its best step, and its near-ties with a `teacher_tolerance`."""
+        if not self.reward_terms.imitation:
+            return {}
+        scores = self.expert_scores()
+        labels = {EXPERT_KEY: torch.from_numpy(best_action(scores))}
+        if self.reward_terms.teacher_tolerance:
+            labels[EXPERT_SET_KEY] = torch.from_numpy(near_best(scores, self.reward_terms.teacher_tolerance))
+        return labels
 
     def _lattice(self, spec: SceneSpec) -> ViewLattice:
         """The scene's lattice: read from the cache without a renderer, or rendered now."""
@@ -417,12 +430,11 @@ class NBVEnv(EnvBase):
         extra = {BOV_KEY: torch.from_numpy(bov_vector(self.bov, self._novelty, self._steps + 1, self._metres,
                                                       self.config, self._looked))
                  } if self.config.bov_observation else {}
-        if self.reward_terms.imitation:
-            extra[EXPERT_KEY] = torch.from_numpy(self.expert_action())
         return TensorDict({
             "pixels": torch.from_numpy(self._frames.copy()),
             "viewpoints": torch.from_numpy(self._locations.astype(np.float32) * self.config.pose_observation),
             **extra,
+            **self._teacher(),
             "done": torch.tensor([terminated or truncated]),
             "terminated": torch.tensor([terminated]),
             "truncated": torch.tensor([truncated]),

@@ -12,6 +12,10 @@ flight. One step alone is too short-sighted: where the next 45 degrees hold noth
 the best spiral from here, chosen again at every view.
 Its actions depend on the building by construction; `RewardConfig.imitation` pulls the actor's mode
 towards them (`nbv.rl.train.sac_update`), so the actor must read its frames and Bag of Views to follow.
+Its best step often beats the runner-up by less than 0.1 coverage points, and the runner-up is often its
+mirror (round 19 of paper_results/selection): a squared-error fit to such labels is their mean. With a
+`RewardConfig.teacher_tolerance` the term pulls the mode to the nearest of the steps within the tolerance
+of the best (`near_best`) instead, and the SAC objective chooses among them.
 
 Example: seen from nowhere yet, the shortest leg that sees the one sample wins (a 45-degree turn, inwards
 and a little up, where the shell's arc is shortest).
@@ -45,6 +49,9 @@ TEACHER_COVERAGE = 100.0
 """The teacher's weight of new coverage against its flight term (the default's coverage reward weight)."""
 EXPERT_KEY = "expert_action"
 """The state's key of the teacher's action (training envs with `RewardConfig.imitation` only)."""
+EXPERT_SET_KEY = "expert_near_best"
+"""The state's key of the teacher's near-ties, bool (125,) over `CANDIDATES` (`near_best`; training envs
+with `RewardConfig.imitation` and a `teacher_tolerance` only)."""
 
 
 CANDIDATES = np.array(list(itertools.product(EXPERT_LEVELS, repeat=3)))
@@ -56,16 +63,16 @@ def candidate_actions() -> np.ndarray:
     return CANDIDATES.copy()
 
 
-def expert_action(view: Viewpoint, seen: np.ndarray, sees: Callable[[Viewpoint], np.ndarray],
+def expert_scores(view: Viewpoint, seen: np.ndarray, sees: Callable[[Viewpoint], np.ndarray],
                   step: Callable[[np.ndarray, Viewpoint], Viewpoint], flight_weight: float,
                   views_left: int, horizon: int, discount: float) -> np.ndarray:
-    """The candidate action of highest score (module docstring) from `view`, given the samples `seen` so
-    far, what each view `sees`, how an action moves (`step(action, view)`), the flight-cost weight per
-    metre, the views still to take, the horizon (0: all of them) and the discount (their defaults are
-    `RewardConfig.teacher_horizon` and `teacher_discount`'s); float32 (3,) in [-1, 1]."""
+    """Every candidate action's score (module docstring), in `CANDIDATES`' order, from `view`, given the
+    samples `seen` so far, what each view `sees`, how an action moves (`step(action, view)`), the flight-cost
+    weight per metre, the views still to take, the horizon (0: all of them) and the discount (their defaults
+    are `RewardConfig.teacher_horizon` and `teacher_discount`'s); float64 (125,), in coverage points."""
     horizon = max(1, min(horizon or views_left, views_left))
-    best, best_score = None, -np.inf
-    for action in CANDIDATES:
+    scores = np.empty(len(CANDIDATES))
+    for i, action in enumerate(CANDIDATES):
         covered, here, score, flown = seen.copy(), view, 0.0, []
         for k in range(horizon):
             here = step(action, here)
@@ -74,7 +81,30 @@ def expert_action(view: Viewpoint, seen: np.ndarray, sees: Callable[[Viewpoint],
             covered |= new
             flown.append(here)
         legs = shell_path(view, flown).legs_m
-        score -= sum(discount ** k * (flight_weight + TIE_BREAK_PER_M) * m for k, m in enumerate(legs))
-        if score > best_score:
-            best, best_score = action, score
-    return best.astype(np.float32)
+        cost = sum(discount ** k * (flight_weight + TIE_BREAK_PER_M) * m for k, m in enumerate(legs))
+        scores[i] = score - cost
+    return scores
+
+
+def expert_action(view: Viewpoint, seen: np.ndarray, sees: Callable[[Viewpoint], np.ndarray],
+                  step: Callable[[np.ndarray, Viewpoint], Viewpoint], flight_weight: float,
+                  views_left: int, horizon: int, discount: float) -> np.ndarray:
+    """The candidate action of highest `expert_scores` (the first in the grid's order among equals), its
+    arguments the same; float32 (3,) in [-1, 1]."""
+    scores = expert_scores(view, seen, sees, step, flight_weight, views_left, horizon, discount)
+    return best_action(scores)
+
+
+def best_action(scores: np.ndarray) -> np.ndarray:
+    """The candidate of highest score (the first among equals); float32 (3,)."""
+    return CANDIDATES[int(np.argmax(scores))].astype(np.float32)
+
+
+def near_best(scores: np.ndarray, tolerance: float) -> np.ndarray:
+    """Which candidates score within `tolerance` (coverage points) of the best: the teacher's near-ties,
+    bool (125,), the best always among them.
+
+    >>> near_best(np.array([1.0, 0.95, 0.5]), 0.1).tolist()
+    [True, True, False]
+    """
+    return scores >= scores.max() - tolerance

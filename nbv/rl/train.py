@@ -68,7 +68,7 @@ from nbv.rl.checkpoint import (
 )
 from nbv.rl.config import OptimConfig, TrainConfig, upgrade_record
 from nbv.rl.env import NBVEnv
-from nbv.rl.expert import EXPERT_KEY
+from nbv.rl.expert import CANDIDATES, EXPERT_KEY, EXPERT_SET_KEY
 from nbv.rl.run_logs import trim_log, validation_fields
 from nbv.rl.validate import Validator, mean_score
 from nbv.viz.figures import plot_training_curves
@@ -302,9 +302,14 @@ def checkpoint_run(run: Path, config: TrainConfig, learner: Learner, frames: int
 
 def mode_distance(actor: ProbabilisticActor, sample: TensorDictBase) -> torch.Tensor:
     """Mean over the sample's states of the squared distance between the actor's mode and the teacher's
-    action (`nbv.rl.expert`), summed over the action's values."""
-    dist = actor.get_dist(sample.select(*actor.in_keys))
-    return ((dist.deterministic_sample - sample[EXPERT_KEY]) ** 2).sum(-1).mean()
+    action (`nbv.rl.expert`), summed over the action's values; where the states hold the teacher's
+    near-ties (`EXPERT_SET_KEY`), the distance to the nearest of them."""
+    mode = actor.get_dist(sample.select(*actor.in_keys)).deterministic_sample
+    if EXPERT_SET_KEY not in sample.keys():
+        return ((mode - sample[EXPERT_KEY]) ** 2).sum(-1).mean()
+    candidates = torch.as_tensor(CANDIDATES, dtype=mode.dtype)
+    distances = ((mode.unsqueeze(-2) - candidates) ** 2).sum(-1)
+    return distances.masked_fill(~sample[EXPERT_SET_KEY], torch.inf).amin(-1).mean()
 
 
 def imitation_loss(loss_module: SACLoss, sample: TensorDictBase) -> torch.Tensor:

@@ -147,7 +147,7 @@ def test_the_run_config_holds_the_term_in_its_reward_group_not_in_the_env():
 
     record = config_record(parse_train(["--preset", "coverage", "--coverage-reward", "30", "--out", "run"]))
     assert record["reward"] == {"coverage": 30.0, "flight": 0.0, "imitation": 0.0, "teacher_horizon": 3,
-                                "teacher_discount": 0.9}
+                                "teacher_discount": 0.9, "teacher_tolerance": 0.0}
     assert "coverage_reward" not in record["env"]
     assert not any("coverage" in field.name for field in fields(EnvConfig))
     with pytest.raises(TypeError, match="coverage_reward"):

@@ -15,8 +15,15 @@ from nbv.features.config import FeatureConfig
 from nbv.rl.builders import make_loss_module, make_optimizers, make_sac_agent
 from nbv.rl.config import EnvConfig, LoggerConfig, RewardConfig, TrainConfig
 from nbv.rl.env import NBVEnv, action_to_viewpoint
-from nbv.rl.expert import EXPERT_KEY, candidate_actions, expert_action
-from nbv.rl.train import IMITATION_FIELD, imitation_loss, sac_update
+from nbv.rl.expert import (
+    EXPERT_KEY,
+    EXPERT_SET_KEY,
+    candidate_actions,
+    expert_action,
+    expert_scores,
+    near_best,
+)
+from nbv.rl.train import IMITATION_FIELD, imitation_loss, mode_distance, sac_update
 from render.camera import UAVCamera
 from render.settings import RenderSettings
 from render.viewpoint import Viewpoint
@@ -135,3 +142,55 @@ def test_bad_imitation_settings_are_refused():
     with pytest.raises(ValueError, match=r"teacher_discount must lie in \(0, 1\]"):
         RewardConfig(teacher_discount=0.0)
     assert replace(RewardConfig(), imitation=2.0).imitation == 2.0
+
+
+def test_the_teachers_action_is_its_best_scored_candidate_and_its_near_ties_hold_it():
+    # From the start, a sample at (150, 200) degrees: +1 or -1 twice both reach it (module test above).
+    scores = expert_scores(START, np.zeros(1, bool), sample_at(150, 200), step, 0.0, 12, **TEACHER)
+    actions = candidate_actions()
+    assert scores.shape == (125,)
+    assert expert_action(START, np.zeros(1, bool), sample_at(150, 200), step, 0.0, 12, **TEACHER
+                         ).tolist() == actions[np.argmax(scores)].tolist()
+    ties = near_best(scores, 0.1)
+    # Within 0.1 points: the largest azimuth step either way (a gain of 0.9 x 100 at the second view,
+    # less legs of about 1e-6 a metre), whatever the radius and elevation steps; nothing else.
+    assert ties[np.argmax(scores)]
+    assert set(actions[ties][:, 1].tolist()) == {-1.0, 1.0} and ties.sum() == 50
+    # Without a tolerance: the best and its mirror, exactly equal.
+    assert actions[near_best(scores, 0.0)].tolist() == [[-1.0, -1.0, 1.0], [-1.0, 1.0, 1.0]]
+
+
+def test_the_training_env_labels_the_teachers_near_ties_with_a_tolerance():
+    env = tiny_env(imitation=1.0, teacher_tolerance=0.5)
+    td = env.reset()
+    for _ in range(3):
+        scores = env.expert_scores()
+        assert td[EXPERT_SET_KEY].tolist() == near_best(scores, 0.5).tolist()
+        assert td[EXPERT_KEY].tolist() == candidate_actions()[np.argmax(scores)].tolist()
+        td = env.step(td.set("action", td[EXPERT_KEY]))["next"]
+    assert EXPERT_SET_KEY not in tiny_env(imitation=1.0).reset().keys()
+
+
+def test_the_near_tie_distance_is_to_the_nearest_tie():
+    # A fixed actor whose mode is 0.8 on every value: the distance to the best step (1, 1, 1) is 3 x 0.04,
+    # to the nearest of {(-1, -1, -1), (0.5, 1, 0.5)} 0.09 + 0.04 + 0.09 = 0.22, and a step outside the
+    # ties, however near, counts nothing.
+    env = EnvConfig(scenes=SceneSet(scene=("test_building",)), camera=UAVCamera(64, 48), obs_size=16)
+    actor = make_sac_agent(env, TrainConfig(env=env, logger=LoggerConfig(out=None)).network)[0]
+    head = actor.module[0].module.head[2]
+    with torch.no_grad():
+        head.weight.zero_()
+        head.bias.copy_(torch.tensor([np.arctanh(0.8)] * 3 + [0.0] * 3))
+    actions = candidate_actions().tolist()
+    ties = torch.zeros(1, 125, dtype=torch.bool)
+    ties[0, actions.index([-1.0, -1.0, -1.0])] = ties[0, actions.index([0.5, 1.0, 0.5])] = True
+    state = {"pixels": torch.zeros(1, 5, 16, 16, dtype=torch.uint8), "viewpoints": torch.zeros(1, 5, 3),
+             EXPERT_KEY: torch.ones(1, 3)}
+    assert mode_distance(actor, TensorDict(state, [1])).item() == pytest.approx(0.12, abs=1e-5)
+    with_ties = TensorDict({**state, EXPERT_SET_KEY: ties}, [1])
+    assert mode_distance(actor, with_ties).item() == pytest.approx(0.22, abs=1e-5)
+
+
+def test_a_negative_tolerance_is_refused():
+    with pytest.raises(ValueError, match="teacher_tolerance must be finite and >= 0"):
+        RewardConfig(teacher_tolerance=-0.1)

@@ -250,7 +250,8 @@ def test_shipped_records_read_into_the_reward_and_members_groups():
     assert "coverage_reward" not in config["env"] and "members" not in config["validation"]
     recorded = json.loads((old.parent / "config.json").read_text())
     assert with_defaults(recorded)["reward"] == {"coverage": 100.0, "flight": 0.0, "imitation": 0.0,
-                                                 "teacher_horizon": 3, "teacher_discount": 0.9}
+                                                 "teacher_horizon": 3, "teacher_discount": 0.9,
+                                                 "teacher_tolerance": 0.0}
     parsed = config_from_record(TrainConfig, config)
     assert parsed.reward.coverage == 100.0 and parsed.members.count == 3
 

@@ -330,6 +330,9 @@ INDEX = (
            "buildings, two more seeds, checkpoints chosen by the exact-render checks", LOOKS_EVAL),
     Result("selection/round18/README.md", "selection/round18/results.json", "its eighteenth round: the "
            "student fitted to its teacher's labels by supervision alone (scripts/dagger.py)", LOOKS_EVAL),
+    Result("selection/round19/README.md", "selection/round19/results.json", "its nineteenth round: the "
+           "teacher's near-ties as labels (--teacher-tolerance): students that look, and fly further",
+           LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

@@ -44,16 +44,15 @@ from common.threads import set_torch_threads
 from nbv.rl.builders import make_environment, make_loss_module, make_sac_agent
 from nbv.rl.checkpoint import save_policy
 from nbv.rl.config import TrainConfig
-from nbv.rl.expert import EXPERT_KEY
+from nbv.rl.expert import EXPERT_KEY, label_keys
 from nbv.rl.presets import PRESETS
 from nbv.rl.train import mode_distance
 from scenes.spec import SceneSet
 
 
-def visit(env, actor, episodes: int, teacher: bool, desc: str) -> list[TensorDict]:
+def visit(env, actor, episodes: int, teacher: bool, desc: str, keys: list[str]) -> list[TensorDict]:
     """The states of `episodes` episodes flown by the teacher's actions or the actor's mode, each with the
-    teacher's label (the observation keys the actor reads, and `EXPERT_KEY`)."""
-    keys = [*actor.in_keys, EXPERT_KEY]
+    `keys` kept (the observation keys the actor reads, and the teacher's labels)."""
     states = []
     with torch.no_grad(), set_exploration_type(ExplorationType.DETERMINISTIC):
         for _ in tqdm(range(episodes), desc=desc, unit="episode"):
@@ -145,7 +144,7 @@ def main(argv: list[str]) -> int:
     loss_module, _ = make_loss_module(actor, critic, config.optim)  # its state dict shares the actor's
     optimiser = torch.optim.Adam(actor.parameters(), lr=args.lr)
     generator = torch.Generator().manual_seed(args.seed)
-    keys = [*actor.in_keys, EXPERT_KEY]
+    keys = [*actor.in_keys, *label_keys(config.reward.teacher_tolerance)]
     pooled, held = seed_states(args.buffers, keys, args.held, generator)
     log = []
     start = time.perf_counter()
@@ -157,7 +156,7 @@ def main(argv: list[str]) -> int:
         print(log[-1], flush=True)
     for iteration in range(args.iterations):
         teacher = iteration == 0 and not pooled  # with seed states the student flies from the start
-        new = visit(env, actor, args.episodes, teacher, f"iteration {iteration}")
+        new = visit(env, actor, args.episodes, teacher, f"iteration {iteration}", keys)
         with torch.no_grad():
             on_policy = mode_distance(actor, torch.stack(new)).item()
         pooled += new

@@ -100,6 +100,12 @@ def best_action(scores: np.ndarray) -> np.ndarray:
     return CANDIDATES[int(np.argmax(scores))].astype(np.float32)
 
 
+def label_keys(tolerance: float) -> list[str]:
+    """The state keys a training env labels with the teacher: its action, and its near-ties with a
+    tolerance > 0 (`RewardConfig.teacher_tolerance`)."""
+    return [EXPERT_KEY, EXPERT_SET_KEY] if tolerance else [EXPERT_KEY]
+
+
 def near_best(scores: np.ndarray, tolerance: float) -> np.ndarray:
     """Which candidates score within `tolerance` (coverage points) of the best: the teacher's near-ties,
     bool (125,), the best always among them.

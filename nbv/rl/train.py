@@ -300,6 +300,10 @@ def checkpoint_run(run: Path, config: TrainConfig, learner: Learner, frames: int
     return best
 
 
+CANDIDATE_ACTIONS = torch.from_numpy(CANDIDATES)
+"""The teacher's candidate steps as a tensor (built once, not at every update)."""
+
+
 def mode_distance(actor: ProbabilisticActor, sample: TensorDictBase) -> torch.Tensor:
     """Mean over the sample's states of the squared distance between the actor's mode and the teacher's
     action (`nbv.rl.expert`), summed over the action's values; where the states hold the teacher's
@@ -307,8 +311,7 @@ def mode_distance(actor: ProbabilisticActor, sample: TensorDictBase) -> torch.Te
     mode = actor.get_dist(sample.select(*actor.in_keys)).deterministic_sample
     if EXPERT_SET_KEY not in sample.keys():
         return ((mode - sample[EXPERT_KEY]) ** 2).sum(-1).mean()
-    candidates = torch.as_tensor(CANDIDATES, dtype=mode.dtype)
-    distances = ((mode.unsqueeze(-2) - candidates) ** 2).sum(-1)
+    distances = ((mode.unsqueeze(-2) - CANDIDATE_ACTIONS.to(mode.dtype)) ** 2).sum(-1)
     return distances.masked_fill(~sample[EXPERT_SET_KEY], torch.inf).amin(-1).mean()
 
 

@@ -333,6 +333,8 @@ INDEX = (
     Result("selection/round19/README.md", "selection/round19/results.json", "its nineteenth round: the "
            "teacher's near-ties as labels (--teacher-tolerance): students that look, and fly further",
            LOOKS_EVAL),
+    Result("selection/round20/README.md", "selection/round20/seed2/results.json", "its twentieth round: "
+           "round 19's near-tie setting over two more seeds, and a middle flight weight", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

@@ -144,7 +144,7 @@ def main(argv: list[str]) -> int:
     loss_module, _ = make_loss_module(actor, critic, config.optim)  # its state dict shares the actor's
     optimiser = torch.optim.Adam(actor.parameters(), lr=args.lr)
     generator = torch.Generator().manual_seed(args.seed)
-    keys = [*actor.in_keys, *label_keys(config.reward.teacher_tolerance)]
+    keys = [*actor.in_keys, *label_keys(config.reward)]
     pooled, held = seed_states(args.buffers, keys, args.held, generator)
     log = []
     start = time.perf_counter()

@@ -83,7 +83,15 @@ from nbv.recon.visibility import SurfaceVisibility, scene_visibility
 from nbv.rl.bov_observation import BOV_KEY, bov_observation_size, bov_vector, novelty_of
 from nbv.rl.config import EnvConfig, RewardConfig
 from nbv.rl.episode_return import RETURN_KEY
-from nbv.rl.expert import CANDIDATES, EXPERT_KEY, EXPERT_SET_KEY, best_action, expert_scores, near_best
+from nbv.rl.expert import (
+    CANDIDATES,
+    EXPERT_KEY,
+    EXPERT_SET_KEY,
+    best_action,
+    expert_scores,
+    label_keys,
+    near_best,
+)
 from nbv.rl.lattice import ViewLattice, build_lattice
 from nbv.rl.look_map import look_of
 from render.viewpoint import TWO_PI, Viewpoint, draw_viewpoint, viewpoint_to_c2w
@@ -176,10 +184,9 @@ class NBVEnv(EnvBase):
         tau, side = config.history, config.obs_size
         extra = {BOV_KEY: Unbounded(shape=(bov_observation_size(config),), dtype=torch.float32)
                  } if config.bov_observation else {}
-        if reward_terms.imitation:
-            extra[EXPERT_KEY] = Bounded(-1.0, 1.0, shape=(3,), dtype=torch.float32)
-        if reward_terms.imitation and reward_terms.teacher_tolerance:
-            extra[EXPERT_SET_KEY] = Categorical(2, shape=(len(CANDIDATES),), dtype=torch.bool)
+        labels = {EXPERT_KEY: Bounded(-1.0, 1.0, shape=(3,), dtype=torch.float32),
+                  EXPERT_SET_KEY: Categorical(2, shape=(len(CANDIDATES),), dtype=torch.bool)}
+        extra.update({key: labels[key] for key in label_keys(reward_terms)})
         self.observation_spec = Composite(
             pixels=Bounded(0, 255, shape=(tau, side, side), dtype=torch.uint8),
             viewpoints=Bounded(-1.0, 1.0, shape=(tau, 3), dtype=torch.float32),
@@ -410,11 +417,12 @@ class NBVEnv(EnvBase):
 
     def _teacher(self) -> dict[str, torch.Tensor]:
         """The state's teacher labels: its best step, and its near-ties with a `teacher_tolerance`."""
-        if not self.reward_terms.imitation:
+        keys = label_keys(self.reward_terms)
+        if not keys:
             return {}
         scores = self.expert_scores()
         labels = {EXPERT_KEY: torch.from_numpy(best_action(scores))}
-        if self.reward_terms.teacher_tolerance:
+        if EXPERT_SET_KEY in keys:
             labels[EXPERT_SET_KEY] = torch.from_numpy(near_best(scores, self.reward_terms.teacher_tolerance))
         return labels
 

@@ -35,11 +35,15 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from nbv.flight.path import shell_path
 from render.viewpoint import Viewpoint
+
+if TYPE_CHECKING:
+    from nbv.rl.config import RewardConfig
 
 EXPERT_LEVELS = (-1.0, -0.5, 0.0, 0.5, 1.0)
 """The action values the teacher tries per coordinate (5^3 = 125 candidate steps)."""
@@ -100,10 +104,12 @@ def best_action(scores: np.ndarray) -> np.ndarray:
     return CANDIDATES[int(np.argmax(scores))].astype(np.float32)
 
 
-def label_keys(tolerance: float) -> list[str]:
-    """The state keys a training env labels with the teacher: its action, and its near-ties with a
-    tolerance > 0 (`RewardConfig.teacher_tolerance`)."""
-    return [EXPERT_KEY, EXPERT_SET_KEY] if tolerance else [EXPERT_KEY]
+def label_keys(terms: RewardConfig) -> list[str]:
+    """The state keys a training env labels with the teacher: none without `imitation`, else its action,
+    and its near-ties with a `teacher_tolerance` > 0."""
+    if not terms.imitation:
+        return []
+    return [EXPERT_KEY, EXPERT_SET_KEY] if terms.teacher_tolerance else [EXPERT_KEY]
 
 
 def near_best(scores: np.ndarray, tolerance: float) -> np.ndarray:

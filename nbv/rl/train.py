@@ -300,8 +300,8 @@ def checkpoint_run(run: Path, config: TrainConfig, learner: Learner, frames: int
     return best
 
 
-CANDIDATE_ACTIONS = torch.from_numpy(CANDIDATES)
-"""The teacher's candidate steps as a tensor (built once, not at every update)."""
+CANDIDATE_ACTIONS = torch.from_numpy(CANDIDATES).float()
+"""The teacher's candidate steps as a float32 tensor, the actor's dtype (built once, not at every update)."""
 
 
 def mode_distance(actor: ProbabilisticActor, sample: TensorDictBase) -> torch.Tensor:

@@ -21,6 +21,7 @@ from nbv.rl.expert import (
     candidate_actions,
     expert_action,
     expert_scores,
+    label_keys,
     near_best,
 )
 from nbv.rl.train import IMITATION_FIELD, imitation_loss, mode_distance, sac_update
@@ -169,6 +170,16 @@ def test_the_training_env_labels_the_teachers_near_ties_with_a_tolerance():
         assert td[EXPERT_KEY].tolist() == candidate_actions()[np.argmax(scores)].tolist()
         td = env.step(td.set("action", td[EXPERT_KEY]))["next"]
     assert EXPERT_SET_KEY not in tiny_env(imitation=1.0).reset().keys()
+
+
+def test_the_labels_follow_the_imitation_and_tolerance_settings_and_the_env_carries_exactly_them():
+    labelled = {EXPERT_KEY, EXPERT_SET_KEY}
+    for terms, keys in (({}, []), ({"teacher_tolerance": 0.5}, []), ({"imitation": 1.0}, [EXPERT_KEY]),
+                        ({"imitation": 1.0, "teacher_tolerance": 0.5}, [EXPERT_KEY, EXPERT_SET_KEY])):
+        assert label_keys(RewardConfig(**terms)) == keys
+        env = tiny_env(**terms)
+        assert labelled & set(env.observation_spec.keys()) == set(keys)
+        assert labelled & set(env.reset().keys()) == set(keys)
 
 
 def test_the_near_tie_distance_is_to_the_nearest_tie():

@@ -10,7 +10,10 @@ For each policy (`--policy NAME=PATH`, a `policy.pt`) and baseline planner (`--b
   policy that looks loses coverage;
 - spread: from the same start view, the mean distance (metres, positions relative to each building's
   centre) between the i-th camera positions on two different buildings, over every pair and seed: an
-  open-loop policy flies the same path everywhere (0 m).
+  open-loop policy flies the same path everywhere (0 m);
+- checks (with `orbit` among the baselines): each policy's issue-26 acceptance checks against the tuned
+  orbit, by the rule `nbv online` applies to held-out buildings (`nbv.experiments.online_acceptance`),
+  counted in the table's `checks` column and listed below it.
 
 Validation buildings only: the script refuses held-out ones (`scenes.family_splits.held_out`).
 
@@ -30,6 +33,7 @@ from tqdm import tqdm
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import git_commit, portable_record
+from nbv.experiments.online_acceptance import Runs, acceptance_checks, acceptance_section
 from nbv.features.source import ViewSource
 from nbv.flight.record import flight_record
 from nbv.flight.spread import pair_spreads_m
@@ -133,9 +137,31 @@ def evaluate(planners: dict[str, tuple[Planner, bool]], trained: EnvConfig, scen
     return results
 
 
-def report(results: dict, scenes: list[str], seeds: list[int], views: int, reference: str) -> str:
+def acceptance_runs(results: dict, scenes: list[str], blank: bool = False) -> Runs:
+    """The runs in `nbv online`'s form (per building, per planner, records with gt coverage, metres,
+    viewpoints and seed), for the acceptance rule; with `blank`, the policies' blank-image coverages."""
+    def records(doc: dict) -> list[dict]:
+        if blank:
+            return [{"gt": {"coverage": c / 100.0}, "seed": int(seed)} for seed, c in doc["blank"].items()]
+        return [{"gt": {"coverage": r["coverage"] / 100.0}, "flight_m": r["flight_m"],
+                 "viewpoints": r["viewpoints"], "seed": int(seed)} for seed, r in doc["runs"].items()]
+
+    return {s: {name: records(d["runs"][s]) for name, d in results.items()
+                if not blank or d["runs"][s]["blank"]} for s in scenes}
+
+
+def policy_acceptance(results: dict, scenes: list[str], policies: list[str]) -> dict[str, list[dict]]:
+    """Each policy's acceptance checks (`nbv.experiments.online_acceptance`) on these runs."""
+    blank = acceptance_runs(results, scenes, blank=True)
+    return acceptance_checks(acceptance_runs(results, scenes), blank if any(blank.values()) else None,
+                             policies)
+
+
+def report(results: dict, scenes: list[str], seeds: list[int], views: int, reference: str,
+           checks: dict[str, list[dict]]) -> str:
     """The results table (markdown): per planner, mean coverage, its gap to `reference`, metres, the looks
-    figures, and each building's coverage."""
+    figures, the acceptance checks passed (`checks`, by policy) and each building's coverage; then the
+    checks one by one."""
     ref = results[reference]["summary"]["coverage"]
     rows = []
     for name, doc in results.items():
@@ -147,13 +173,21 @@ def report(results: dict, scenes: list[str], seeds: list[int], views: int, refer
         rows.append([name, f"{mean:.1f}", f"{mean - float(np.mean(list(ref.values()))):+.1f}",
                      f"{min(cov[s] - ref[s] for s in scenes):+.1f}",
                      f"{np.mean(list(summary['flight_m'].values())):.1f}", f"{summary['spread_m']:.2f}", drop,
-                     *(f"{cov[s]:.1f}" for s in scenes)])
+                     passed(checks[name]) if name in checks else "-", *(f"{cov[s]:.1f}" for s in scenes)])
     head = ["planner", "coverage %", f"vs {reference}", f"worst vs {reference}", "metres", "spread m",
-            "blank drop", *scenes]
+            "blank drop", "checks", *scenes]
+    section = "\n".join(acceptance_section(checks, len(scenes))) + "\n" if checks else ""
     return (f"Visible-surface coverage (%) of the true mesh at {views} views, mean over start views "
             f"{', '.join(map(str, seeds))}, on validation buildings; metres along the viewing shell; spread: "
             "mean distance between camera positions on two buildings from the same start; blank drop: "
-            "coverage lost with blank images.\n\n" + markdown_table(head, rows))
+            "coverage lost with blank images; checks: issue 26's acceptance checks passed (below).\n\n"
+            + markdown_table(head, rows) + section)
+
+
+def passed(checks: list[dict]) -> str:
+    """How many of a policy's acceptance checks pass, of those with a bar: "4/6"."""
+    barred = [c for c in checks if c["passed"] is not None]
+    return f"{sum(c['passed'] for c in barred)}/{len(barred)}"
 
 
 def study_arguments(parser: argparse.ArgumentParser) -> None:
@@ -188,8 +222,9 @@ def main() -> None:
     planners |= {name: (make_planner(name, PlanSettings(), seed=0), False) for name in args.baselines}
     args.work.mkdir(parents=True, exist_ok=True)
     results = evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work, not args.no_blank)
+    checks = policy_acceptance(results, args.scenes, list(policies)) if "orbit" in args.baselines else {}
     table = report(results, args.scenes, args.seeds, args.views, args.baselines[0] if args.baselines else
-                   next(iter(policies)))
+                   next(iter(policies)), checks)
     outputs = ("results.json", "results.md", "coverage.png")
     with atomic_folder(args.out, overwrite=True, outputs=outputs) as out:
         write_text(out / "results.md", table)
@@ -198,7 +233,8 @@ def main() -> None:
                          "13 views: policies vs the tuned orbit")
         write_json(out / "results.json", portable_record({
             "commit": git_commit(), "scenes": args.scenes, "seeds": args.seeds, "views": args.views,
-            "policies": dict(p.split("=", 1) for p in args.policy), "results": results, "command": sys.argv}))
+            "policies": dict(p.split("=", 1) for p in args.policy), "results": results, "checks": checks,
+            "command": sys.argv}))
     print(table)
 
 

@@ -1,0 +1,69 @@
+"""`scripts/looks_eval.py`'s acceptance checks on hand-made runs: the rule `nbv online` applies, counted."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def looks_eval():
+    spec = importlib.util.spec_from_file_location("looks_eval", ROOT / "scripts" / "looks_eval.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def building(coverage: list[float], metres: float, radius: float, blank: list[float] | None = None) -> dict:
+    """One planner's runs on one building from start views 0 and 1, as `score_scene` keeps them."""
+    path = [[radius, 0.5, 0.3], [radius, 1.0, 0.3]]
+    runs = {str(seed): {"coverage": c, "flight_m": metres, "viewpoints": path, "start": [2.0, 0.0, 0.3]}
+            for seed, c in enumerate(coverage)}
+    return {"runs": runs, "blank": {str(seed): c for seed, c in enumerate(blank or [])}}
+
+
+def results() -> dict:
+    """A policy at 1.5 m on building a, 2.0 m on b; the orbit and random views at 2.0 m on both."""
+    return {"pol": {"runs": {"a": building([95.0, 97.0], 12.0, 1.5, blank=[90.0, 90.0]),
+                             "b": building([90.0, 90.0], 14.0, 2.0, blank=[89.0, 89.0])}},
+            "orbit": {"runs": {"a": building([90.0, 90.0], 9.0, 2.0), "b": building([90.5, 90.5], 9.0, 2.0)}},
+            "random": {"runs": {"a": building([89.0, 91.0], 30.0, 2.0),
+                                "b": building([84.0, 84.0], 30.0, 2.0)}}}
+
+
+def test_checks_follow_the_held_out_rule_by_hand():
+    module = looks_eval()
+    checks = module.policy_acceptance(results(), ["a", "b"], ["pol"])["pol"]
+    by = {c["check"].split(",")[0]: c for c in checks}
+    # Policy 96 and 90 per building (mean 93), orbit 90 and 90.5 (90.25): +2.75, worst b -0.5.
+    assert by["mean coverage minus the tuned orbit's"]["value"] == pytest.approx(2.75)
+    assert not by["mean coverage minus the tuned orbit's"]["passed"]
+    assert by["worst building minus the tuned orbit"]["value"] == pytest.approx(-0.5)
+    assert by["worst building minus the tuned orbit"]["passed"]
+    # Random 90 and 84: the policy is 6 above on both.
+    assert by["worst building minus random"]["value"] == pytest.approx(6.0)
+    assert by["worst building minus random"]["passed"]
+    # 13 m against 9 m: 1.44x.
+    assert by["metres flown over the tuned orbit's"]["value"] == pytest.approx(13.0 / 9.0)
+    assert by["metres flown over the tuned orbit's"]["passed"]
+    # Same directions, radii 1.5 and 2.0 m: every camera 0.5 m apart.
+    assert by["path spread"]["value"] == pytest.approx(0.5)
+    # Blank 90 and 89 (89.5) against 93: 3.5 points lost.
+    assert by["coverage lost with blank images"]["value"] == pytest.approx(3.5)
+    assert module.passed(checks) == "5/6"
+
+
+def test_report_counts_the_checks_and_lists_them():
+    module = looks_eval()
+    runs = results()
+    for name, doc in runs.items():
+        doc["summary"] = module.summarise(doc["runs"], ["a", "b"], [0, 1])
+    checks = module.policy_acceptance(runs, ["a", "b"], ["pol"])
+    table = module.report(runs, ["a", "b"], [0, 1], 13, "orbit", checks)
+    assert "| pol | 93.0 | +2.8 | -0.5 | 13.0 | 0.50 | 3.5 | 5/6 | 96.0 | 90.0 |" in table
+    assert "| orbit | 90.2 | +0.0 | +0.0 | 9.0 | 0.00 | - | - | 90.0 | 90.5 |" in table
+    assert "| mean coverage minus the tuned orbit's, points | >= +3.0 | +2.8 (no) |" in table
+    assert "| **every check** |  | **no** |" in table

@@ -335,6 +335,8 @@ INDEX = (
            LOOKS_EVAL),
     Result("selection/round20/README.md", "selection/round20/seed2/results.json", "its twentieth round: "
            "round 19's near-tie setting over two more seeds, and a middle flight weight", LOOKS_EVAL),
+    Result("selection/round21/README.md", "selection/round21/seed2/results.json", "its twenty-first round: "
+           "the default setting over four more seeds, the checks counted by the script", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

@@ -2,19 +2,9 @@
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
-
-
-def looks_eval():
-    spec = importlib.util.spec_from_file_location("looks_eval", ROOT / "scripts" / "looks_eval.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+from scripts import looks_eval as module
 
 
 def building(coverage: list[float], metres: float, radius: float, blank: list[float] | None = None) -> dict:
@@ -35,7 +25,6 @@ def results() -> dict:
 
 
 def test_checks_follow_the_held_out_rule_by_hand():
-    module = looks_eval()
     checks = module.policy_acceptance(results(), ["a", "b"], ["pol"])["pol"]
     by = {c["check"].split(",")[0]: c for c in checks}
     # Policy 96 and 90 per building (mean 93), orbit 90 and 90.5 (90.25): +2.75, worst b -0.5.
@@ -57,7 +46,6 @@ def test_checks_follow_the_held_out_rule_by_hand():
 
 
 def test_report_counts_the_checks_and_lists_them():
-    module = looks_eval()
     runs = results()
     for name, doc in runs.items():
         doc["summary"] = module.summarise(doc["runs"], ["a", "b"], [0, 1])

@@ -33,7 +33,7 @@ from tqdm import tqdm
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import git_commit, portable_record
-from nbv.experiments.online_acceptance import Runs, acceptance_checks, acceptance_section
+from nbv.experiments.online_acceptance import Runs, acceptance_checks, acceptance_section, tally
 from nbv.features.source import ViewSource
 from nbv.flight.record import flight_record
 from nbv.flight.spread import pair_spreads_m
@@ -185,9 +185,8 @@ def report(results: dict, scenes: list[str], seeds: list[int], views: int, refer
 
 
 def passed(checks: list[dict]) -> str:
-    """How many of a policy's acceptance checks pass, of those with a bar: "4/6"."""
-    barred = [c for c in checks if c["passed"] is not None]
-    return f"{sum(c['passed'] for c in barred)}/{len(barred)}"
+    """How many of a policy's acceptance checks pass, of those with a bar (`tally`): "4/6"."""
+    return "{}/{}".format(*tally(checks))
 
 
 def study_arguments(parser: argparse.ArgumentParser) -> None:

@@ -47,7 +47,7 @@ def test_checks_follow_the_held_out_rule_by_hand():
 
 def test_report_counts_the_checks_and_lists_them():
     runs = results()
-    for name, doc in runs.items():
+    for doc in runs.values():
         doc["summary"] = module.summarise(doc["runs"], ["a", "b"], [0, 1])
     checks = module.policy_acceptance(runs, ["a", "b"], ["pol"])
     table = module.report(runs, ["a", "b"], [0, 1], 13, "orbit", checks)

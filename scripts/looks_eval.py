@@ -33,7 +33,13 @@ from tqdm import tqdm
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import git_commit, portable_record
-from nbv.experiments.online_acceptance import Runs, acceptance_checks, acceptance_section, tally
+from nbv.experiments.online_acceptance import (
+    Runs,
+    acceptance_checks,
+    acceptance_section,
+    building_mean,
+    tally,
+)
 from nbv.features.source import ViewSource
 from nbv.flight.record import flight_record
 from nbv.flight.spread import pair_spreads_m
@@ -167,12 +173,12 @@ def report(results: dict, scenes: list[str], seeds: list[int], views: int, refer
     for name, doc in results.items():
         summary = doc["summary"]
         cov = summary["coverage"]
-        mean = float(np.mean(list(cov.values())))
+        mean = building_mean(cov)
         blank = summary.get("blank")
-        drop = f"{mean - float(np.mean(list(blank.values()))):.1f}" if blank else "-"
-        rows.append([name, f"{mean:.1f}", f"{mean - float(np.mean(list(ref.values()))):+.1f}",
+        drop = f"{mean - building_mean(blank):.1f}" if blank else "-"
+        rows.append([name, f"{mean:.1f}", f"{mean - building_mean(ref):+.1f}",
                      f"{min(cov[s] - ref[s] for s in scenes):+.1f}",
-                     f"{np.mean(list(summary['flight_m'].values())):.1f}", f"{summary['spread_m']:.2f}", drop,
+                     f"{building_mean(summary['flight_m']):.1f}", f"{summary['spread_m']:.2f}", drop,
                      passed(checks[name]) if name in checks else "-", *(f"{cov[s]:.1f}" for s in scenes)])
     head = ["planner", "coverage %", f"vs {reference}", f"worst vs {reference}", "metres", "spread m",
             "blank drop", "checks", *scenes]

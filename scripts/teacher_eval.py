@@ -20,10 +20,9 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-import numpy as np
-
 from common.io import atomic_folder, write_json, write_text
 from common.provenance import git_commit, portable_record
+from nbv.experiments.online_acceptance import building_mean
 from nbv.planning.base import Planner
 from nbv.planning.config import PlanSettings
 from nbv.planning.registry import make_planner
@@ -35,7 +34,13 @@ from nbv.viz.figures import plot_seed_scores
 from render.viewpoint import Viewpoint
 
 sys.path.insert(0, str(Path(__file__).parent))
-from looks_eval import evaluate, refuse_held_out, report, study_arguments  # noqa: E402
+from looks_eval import (  # noqa: E402
+    evaluate,
+    policy_acceptance,
+    refuse_held_out,
+    report,
+    study_arguments,
+)
 
 
 class TeacherPlanner(Planner):
@@ -63,6 +68,10 @@ class TeacherPlanner(Planner):
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--flight-reward", type=float, nargs="+", default=[0.5])
+    parser.add_argument("--flight-allowance", type=float, default=0.0,
+                        help="metres of an episode free of --flight-excess-reward (nbv.rl.flight_cost)")
+    parser.add_argument("--flight-excess-reward", type=float, default=0.0,
+                        help="the hinge's weight per metre past the allowance; 0: the linear term alone")
     parser.add_argument("--teacher-horizon", type=int, default=3, help="0: to the end of the budget")
     parser.add_argument("--teacher-discount", type=float, default=0.9)
     parser.add_argument("--action-mode", choices=("relative", "orbit", "forward"), default=None,
@@ -79,12 +88,15 @@ def main() -> None:
     teacher = f"teacher_h{args.teacher_horizon}_d{args.teacher_discount:g}"
     if trained != preset:
         teacher += f"_{trained.action_mode}{trained.relative_step:.3g}"
+    hinge = f"_a{args.flight_allowance:g}x{args.flight_excess_reward:g}" if args.flight_excess_reward else ""
     for w in args.flight_reward:
-        terms = RewardConfig(imitation=1.0, flight=w, teacher_horizon=args.teacher_horizon,
+        terms = RewardConfig(imitation=1.0, flight=w, flight_allowance=args.flight_allowance,
+                             flight_excess=args.flight_excess_reward, teacher_horizon=args.teacher_horizon,
                              teacher_discount=args.teacher_discount)
-        planners[f"{teacher}_w{w:g}"] = (TeacherPlanner(trained, terms), False)
+        planners[f"{teacher}_w{w:g}{hinge}"] = (TeacherPlanner(trained, terms), False)
     results = evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work)
-    table = report(results, args.scenes, args.seeds, args.views, "orbit")
+    checks = policy_acceptance(results, args.scenes, [name for name in planners if name.startswith(teacher)])
+    table = report(results, args.scenes, args.seeds, args.views, "orbit", checks)
     outputs = ("results.json", "results.md", "coverage.png")
     with atomic_folder(args.out, overwrite=True, outputs=outputs) as out:
         write_text(out / "results.md", table)
@@ -93,9 +105,9 @@ def main() -> None:
                          f"{args.views} views: the teacher vs the tuned orbit")
         write_json(out / "results.json", portable_record({
             "commit": git_commit(), "scenes": args.scenes, "seeds": args.seeds, "views": args.views,
-            "results": results, "command": sys.argv}))
+            "results": results, "checks": checks, "command": sys.argv}))
     print(table)
-    print("mean coverage:", {n: round(float(np.mean(list(d["summary"]["coverage"].values()))), 1)
+    print("mean coverage:", {n: round(building_mean(d["summary"]["coverage"]), 1)
                              for n, d in results.items()})
 
 

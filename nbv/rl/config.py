@@ -332,6 +332,14 @@ class RewardConfig:
     """Weight W of a flight-cost term: minus W x the metres of the leg to the new view along the viewing
     shell (`nbv.flight.shell_path`), beyond the paper. 0: no flight cost."""
 
+    flight_allowance: Annotated[float, arg(name="flight-allowance")] = 0.0
+    """Metres of an episode's flight free of `flight_excess` (`nbv.rl.flight_cost`: a hinge at a battery's
+    metres, so the flight below it is not traded against coverage). 0: the excess applies to every metre."""
+
+    flight_excess: Annotated[float, arg(name="flight-excess-reward")] = 0.0
+    """Weight W of the hinge's term: minus W x the metres of a leg past `flight_allowance`, in the reward
+    and the teacher's scores alike. 0: the linear flight term alone."""
+
     imitation: Annotated[float, arg(name="imitation")] = 0.0
     """Weight W of an imitation term in the actor's loss (beyond the paper): W x the squared distance
     between the actor's mode and the privileged teacher's action (`nbv.rl.expert`: the candidate step that
@@ -362,6 +370,10 @@ class RewardConfig:
             raise ValueError(f"coverage_reward must be finite and >= 0, got {self.coverage}")
         if not 0 <= self.flight < math.inf:
             raise ValueError(f"flight_reward must be finite and >= 0, got {self.flight}")
+        if not 0 <= self.flight_excess < math.inf:
+            raise ValueError(f"flight_excess_reward must be finite and >= 0, got {self.flight_excess}")
+        if not 0 <= self.flight_allowance < math.inf:
+            raise ValueError(f"flight_allowance must be finite and >= 0 metres, got {self.flight_allowance}")
 
 
 @dataclass(frozen=True)

@@ -92,6 +92,7 @@ from nbv.rl.expert import (
     label_keys,
     near_best,
 )
+from nbv.rl.flight_cost import flight_cost
 from nbv.rl.lattice import ViewLattice, build_lattice
 from nbv.rl.look_map import look_of
 from render.viewpoint import TWO_PI, Viewpoint, draw_viewpoint, viewpoint_to_c2w
@@ -212,7 +213,7 @@ class NBVEnv(EnvBase):
         self._resume_pending = False
         self._view: Viewpoint | None = None
         self._return = torch.zeros(1)  # the episode's return so far (float32, summed as `RewardSum` does)
-        self._novelty, self._metres = 0.0, 0.0  # the last view's novelty, the metres flown (bov_observation)
+        self._novelty, self._metres = 0.0, 0.0  # the last view's novelty, the metres flown
         self._looked: np.ndarray | None = None  # where the episode has looked from (look_map)
         self._set_seed(seed)
 
@@ -262,11 +263,13 @@ class NBVEnv(EnvBase):
             seen = self.surface_seen(view)
             reward += self.reward_terms.coverage * float((seen & ~self._seen).mean())
             self._seen |= seen
-        if self.reward_terms.flight or self.config.bov_observation:
+        terms = self.reward_terms
+        if terms.flight or terms.flight_excess or self.config.bov_observation:
             leg_m = shell_path(self._view, [view]).total_m
+            reward -= flight_cost(terms.flight, self._metres, leg_m, terms.flight_allowance,
+                                  terms.flight_excess)
             self._metres += leg_m
             self._novelty = novelty_of(bov_reward, self.bov)
-            reward -= self.reward_terms.flight * leg_m
         if self.config.look_map:
             self._looked = np.maximum(self._looked, look_of(view))
         self._progress += wrap_angle(view.azimuth - self._view.azimuth)
@@ -344,7 +347,7 @@ class NBVEnv(EnvBase):
             "progress": self._progress, "steps": self._steps, "bov": self.bov.state_dict(),
             "episode_return": self._return.clone(),
             **({"seen": torch.from_numpy(self._seen.copy())} if self._seen is not None else {}),
-            **({"novelty": self._novelty, "metres": self._metres} if self.config.bov_observation else {}),
+            "novelty": self._novelty, "metres": self._metres,
             **({"looked": torch.from_numpy(self._looked.copy())} if self.config.look_map else {}),
         }
 
@@ -413,7 +416,8 @@ class NBVEnv(EnvBase):
         views_left = (self.config.episode_views or self.config.max_steps + 1) - self._steps - 1
         terms = self.reward_terms
         return expert_scores(self._view, self._seen, self.surface_seen, step, terms.flight, views_left,
-                             terms.teacher_horizon, terms.teacher_discount)
+                             terms.teacher_horizon, terms.teacher_discount, flown_m=self._metres,
+                             allowance_m=terms.flight_allowance, excess_weight=terms.flight_excess)
 
     def _teacher(self) -> dict[str, torch.Tensor]:
         """The state's teacher labels: its best step, and its near-ties with a `teacher_tolerance`."""

@@ -1,15 +1,16 @@
 """A privileged teacher for training: the step the true surface says is best (beyond the paper; rl.md §4).
 
-The env's actions are small steps (`relative` mode): a constant step is a fixed spiral, which needs no
-state, and SAC settles on one whatever the building (paper_results/selection/round6). The teacher reads
-what a trained policy may not: the true surface's samples its episode has seen so far. Each of a grid of
-actions (`EXPERT_LEVELS` per coordinate) is scored by flying it `horizon` times over (`RewardConfig.
-teacher_horizon`; fewer where the budget ends first, 0: to the end of it): for each of those views, the
-share of samples it is the first to see times `TEACHER_COVERAGE`, less the flight-cost weight times its
-leg's metres along the viewing shell, discounted by `discount` per step ahead; ties go to the shortest
-flight. One step alone is too short-sighted: where the next 45 degrees hold nothing new, it hovers
-(measured on `test_building`: stuck at 86 %). With the horizon at the budget's end and no discount it is
-the best spiral from here, chosen again at every view.
+The env's actions are small steps (`relative` mode): a constant step is a fixed spiral, which needs no state,
+and SAC settles on one whatever the building (paper_results/selection/round6). The teacher reads what a
+trained policy may not: the true surface's samples its episode has seen so far. Each of a grid of actions
+(`EXPERT_LEVELS` per coordinate) is scored by flying it `horizon` times over (`RewardConfig.teacher_horizon`;
+fewer where the budget ends first, 0: to the end of it): for each of those views, the share of samples it is
+the first to see times `TEACHER_COVERAGE`, less the flight-cost weight times its leg's metres along the
+viewing shell (with a hinge, `nbv.rl.flight_cost`, also its excess weight times the leg's part past the
+episode's allowance, counted from the metres already flown), discounted by `discount` per step ahead; ties go
+to the shortest flight. One step alone is too short-sighted: where the next 45 degrees hold nothing new, it
+hovers (measured on `test_building`: stuck at 86 %). With the horizon at the budget's end and no discount it
+is the best spiral from here, chosen again at every view.
 Its actions depend on the building by construction; `RewardConfig.imitation` pulls the actor's mode
 towards them (`nbv.rl.train.sac_update`), so the actor must read its frames and Bag of Views to follow.
 Its best step often beats the runner-up by less than 0.1 coverage points, and the runner-up is often its
@@ -40,6 +41,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from nbv.flight.path import shell_path
+from nbv.rl.flight_cost import flight_cost
 from render.viewpoint import Viewpoint
 
 if TYPE_CHECKING:
@@ -69,11 +71,13 @@ def candidate_actions() -> np.ndarray:
 
 def expert_scores(view: Viewpoint, seen: np.ndarray, sees: Callable[[Viewpoint], np.ndarray],
                   step: Callable[[np.ndarray, Viewpoint], Viewpoint], flight_weight: float,
-                  views_left: int, horizon: int, discount: float) -> np.ndarray:
+                  views_left: int, horizon: int, discount: float, *, flown_m: float = 0.0,
+                  allowance_m: float = 0.0, excess_weight: float = 0.0) -> np.ndarray:
     """Every candidate action's score (module docstring), in `CANDIDATES`' order, from `view`, given the
     samples `seen` so far, what each view `sees`, how an action moves (`step(action, view)`), the flight-cost
     weight per metre, the views still to take, the horizon (0: all of them) and the discount (their defaults
-    are `RewardConfig.teacher_horizon` and `teacher_discount`'s); float64 (125,), in coverage points."""
+    are `RewardConfig.teacher_horizon` and `teacher_discount`'s), and the hinge's terms (`flight_cost`:
+    metres flown so far, the allowance, the excess weight); float64 (125,), in coverage points."""
     horizon = max(1, min(horizon or views_left, views_left))
     scores = np.empty(len(CANDIDATES))
     for i, action in enumerate(CANDIDATES):
@@ -85,17 +89,19 @@ def expert_scores(view: Viewpoint, seen: np.ndarray, sees: Callable[[Viewpoint],
             covered |= new
             flown.append(here)
         legs = shell_path(view, flown).legs_m
-        cost = sum(discount ** k * (flight_weight + TIE_BREAK_PER_M) * m for k, m in enumerate(legs))
+        before = flown_m + np.concatenate([[0.0], np.cumsum(legs)[:-1]])
+        cost = sum(discount ** k * (flight_cost(flight_weight, b, m, allowance_m, excess_weight)
+                                    + TIE_BREAK_PER_M * m) for k, (b, m) in enumerate(zip(before, legs)))
         scores[i] = score - cost
     return scores
 
 
 def expert_action(view: Viewpoint, seen: np.ndarray, sees: Callable[[Viewpoint], np.ndarray],
                   step: Callable[[np.ndarray, Viewpoint], Viewpoint], flight_weight: float,
-                  views_left: int, horizon: int, discount: float) -> np.ndarray:
+                  views_left: int, horizon: int, discount: float, **hinge: float) -> np.ndarray:
     """The candidate action of highest `expert_scores` (the first in the grid's order among equals), its
     arguments the same; float32 (3,) in [-1, 1]."""
-    scores = expert_scores(view, seen, sees, step, flight_weight, views_left, horizon, discount)
+    scores = expert_scores(view, seen, sees, step, flight_weight, views_left, horizon, discount, **hinge)
     return best_action(scores)
 
 

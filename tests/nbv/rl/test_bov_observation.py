@@ -1,8 +1,8 @@
 """The Bag of Views observation (`EnvConfig.bov_observation`), the flight-cost reward term, blank images and
 the pose observation. The vector off: the state and the networks are the paper's bit-for-bit (the shipped
-policy acts as it did); on: the vector on a hand-worked Bag of Views. The flight term on a hand-worked leg.
-Blank images change the state and reach the policy planners from `nbv plan --blank-images`. The poses off:
-the state holds none, and the env flies the same views."""
+policy acts as it did); on: the vector on a hand-worked Bag of Views. The flight term and its hinge on
+hand-worked legs. Blank images change the state and reach the policy planners from `nbv plan
+--blank-images`. The poses off: the state holds none, and the env flies the same views."""
 
 from __future__ import annotations
 
@@ -124,6 +124,20 @@ def test_the_flight_term_costs_w_times_the_legs_metres():
     assert RewardConfig().flight == 0.0
     with pytest.raises(ValueError, match="flight_reward must be finite and >= 0"):
         RewardConfig(flight=-1.0)
+
+
+def test_the_hinge_costs_only_the_metres_past_the_allowance():
+    _, plain, views = fly(NBVEnv(config(), seed=2))
+    first, second = (shell_path(a, [b]).total_m for a, b in zip(views, views[1:]))
+    # The allowance ends halfway along the second leg: the first leg costs nothing, the second its half past.
+    terms = RewardConfig(flight_allowance=first + second / 2, flight_excess=4.0)
+    _, hinged, _ = fly(NBVEnv(config(), seed=2, reward_terms=terms))
+    assert hinged[0] == pytest.approx(plain[0], abs=1e-6)
+    assert hinged[1] == pytest.approx(plain[1] - 4.0 * second / 2, abs=1e-5)
+    with pytest.raises(ValueError, match="flight_excess_reward must be finite and >= 0"):
+        RewardConfig(flight_excess=-1.0)
+    with pytest.raises(ValueError, match="flight_allowance must be finite and >= 0 metres"):
+        RewardConfig(flight_allowance=math.inf)
 
 
 def test_blank_images_change_the_state():

@@ -146,7 +146,8 @@ def test_the_run_config_holds_the_term_in_its_reward_group_not_in_the_env():
     from nbv.cli.train import parse_train
 
     record = config_record(parse_train(["--preset", "coverage", "--coverage-reward", "30", "--out", "run"]))
-    assert record["reward"] == {"coverage": 30.0, "flight": 0.0, "imitation": 0.0, "teacher_horizon": 3,
+    assert record["reward"] == {"coverage": 30.0, "flight": 0.0, "flight_allowance": 0.0,
+                                "flight_excess": 0.0, "imitation": 0.0, "teacher_horizon": 3,
                                 "teacher_discount": 0.9, "teacher_tolerance": 0.0}
     assert "coverage_reward" not in record["env"]
     assert not any("coverage" in field.name for field in fields(EnvConfig))

@@ -89,6 +89,20 @@ def test_a_seen_sample_counts_nothing_and_a_dear_flight_keeps_it_home():
                          ).tolist() == [0, 0, 0]
 
 
+def test_past_its_allowance_the_hinge_keeps_the_teacher_home():
+    # The shortest leg that sees the sample is 1.29 m (above) and the sample is worth 100. Within the
+    # allowance no metre costs; 9.5 m flown of a 10 m allowance, 0.79 m of the leg are past it: at 100 a
+    # metre past, 79 < 100 and it flies; at 150, 118 > 100 and it stays.
+    unseen, near = np.zeros(1, bool), sample_at(30, 100)
+    hinge = {"allowance_m": 10.0, "excess_weight": 150.0}
+    assert expert_action(START, unseen, near, step, 0.0, 1, **TEACHER, flown_m=0.0, **hinge).tolist() == [
+        -1, 0.5, 0.5]
+    assert expert_action(START, unseen, near, step, 0.0, 1, **TEACHER, flown_m=9.5, **hinge).tolist() == [
+        0, 0, 0]
+    assert expert_action(START, unseen, near, step, 0.0, 1, **TEACHER, flown_m=9.5, allowance_m=10.0,
+                         excess_weight=100.0).tolist() == [-1, 0.5, 0.5]
+
+
 def tiny_env(**terms) -> NBVEnv:
     config = EnvConfig(scenes=SceneSet(scene=("test_building",)), camera=UAVCamera(64, 48),
                        render=RenderSettings(spp=1),

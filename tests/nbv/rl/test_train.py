@@ -249,7 +249,8 @@ def test_shipped_records_read_into_the_reward_and_members_groups():
     assert config["reward"] == {"coverage": 100.0} and config["members"] == {"count": 3}
     assert "coverage_reward" not in config["env"] and "members" not in config["validation"]
     recorded = json.loads((old.parent / "config.json").read_text())
-    assert with_defaults(recorded)["reward"] == {"coverage": 100.0, "flight": 0.0, "imitation": 0.0,
+    assert with_defaults(recorded)["reward"] == {"coverage": 100.0, "flight": 0.0, "flight_allowance": 0.0,
+                                                 "flight_excess": 0.0, "imitation": 0.0,
                                                  "teacher_horizon": 3, "teacher_discount": 0.9,
                                                  "teacher_tolerance": 0.0}
     parsed = config_from_record(TrainConfig, config)

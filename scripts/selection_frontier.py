@@ -1,0 +1,135 @@
+"""Coverage against metres over selection rounds: every scored actor's gain over the tuned ring and its
+metres as a multiple of the ring's, against issue 26's two bars (+3 points, 1.5x), from the results files
+of `scripts/looks_eval.py` and `scripts/teacher_eval.py` (validation buildings only, as they are).
+
+Each `--results GROUP=PATH` is one such `results.json`; a planner scored in several files (the shipped
+actor, the baselines) is taken from the first that has it. An actor "looks" where blank images cost it at
+least 3 points (the looks check's bar). Writes `frontier.md` (every actor, and per group how many sit
+inside both bars and how many look) and `frontier.png`.
+
+    python scripts/selection_frontier.py \
+        --results "default=paper_results/selection/round21/seed2/results.json" \
+        --results "hinge=paper_results/selection/round22/hinge_seed1/results.json" --out OUT
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from matplotlib.figure import Figure
+
+from common.io import atomic_folder, markdown_table, write_text
+from nbv.experiments.online_acceptance import building_mean
+from nbv.viz.figures import save_figure
+
+REFERENCE = "orbit"
+"""The tuned single ring every gain and metres ratio is taken against."""
+MARGIN, METRES_BAR, LOOKS_BAR = 3.0, 1.5, 3.0
+"""Issue 26's bars: points over the ring, metres over the ring's, points lost with blank images."""
+BASELINES = ("orbit", "orbit2", "random")
+"""Fixed planners, drawn once and labelled, not counted in a group."""
+
+
+def frontier_points(files: list[tuple[str, dict]], exclude: tuple[str, ...] = ()) -> list[dict]:
+    """One point per planner (first file that has it, none of `exclude`): its group, name, gain over the
+    ring (points), metres over the ring's, and blank drop (points, None without blank flights)."""
+    points, seen = [], set(exclude)
+    for group, doc in files:
+        ring = doc["results"][REFERENCE]["summary"]
+        ring_cover, ring_metres = building_mean(ring["coverage"]), building_mean(ring["flight_m"])
+        for name, result in doc["results"].items():
+            if name in seen:
+                continue
+            seen.add(name)
+            summary = result["summary"]
+            cover = building_mean(summary["coverage"])
+            blank = summary.get("blank")
+            metres = building_mean(summary["flight_m"])
+            points.append({"group": "baseline" if name in BASELINES else group, "name": name,
+                           "gain": cover - ring_cover, "ratio": metres / ring_metres,
+                           "drop": cover - building_mean(blank) if blank else None})
+    return points
+
+
+def inside(point: dict) -> bool:
+    """Whether a point passes both the margin and the metres bar."""
+    return point["gain"] >= MARGIN and point["ratio"] <= METRES_BAR
+
+
+def looks(point: dict) -> bool:
+    """Whether blank images cost the point's planner at least the looks bar."""
+    return point["drop"] is not None and point["drop"] >= LOOKS_BAR
+
+
+def report(points: list[dict]) -> str:
+    """The groups' counts, then every point (markdown)."""
+    groups = list(dict.fromkeys(p["group"] for p in points if p["group"] != "baseline"))
+    counts = []
+    for group in groups:
+        mine = [p for p in points if p["group"] == group]
+        counts.append([group, len(mine), sum(map(inside, mine)), sum(map(looks, mine)),
+                       sum(inside(p) and looks(p) for p in mine)])
+    rows = [[p["group"], p["name"], f"{p['gain']:+.2f}", f"{p['ratio']:.2f}x",
+             "-" if p["drop"] is None else f"{p['drop']:.1f}", "yes" if inside(p) else "no"] for p in points]
+    head = ["group", "planner", "vs orbit", "metres", "blank drop", "inside"]
+    return (f"Validation buildings, 13 views: mean coverage over the tuned ring (`{REFERENCE}`) and metres "
+            f"over its metres; inside: at least +{MARGIN:g} points within {METRES_BAR:g}x; looks: blank "
+            f"images cost at least {LOOKS_BAR:g} points.\n\n"
+            + markdown_table(["group", "actors", "inside both bars", "look", "inside and look"], counts)
+            + "\n\n" + markdown_table(head, rows) + "\n")
+
+
+def plot(points: list[dict], out: Path) -> Path:
+    """Gain against metres ratio, one colour per group, filled where the actor looks (a cross: no blank
+    flights); the baselines starred; the bars dashed."""
+    fig = Figure(figsize=(7.5, 5.0))
+    ax = fig.subplots()
+    groups = list(dict.fromkeys(p["group"] for p in points if p["group"] != "baseline"))
+    kinds = {"looks": looks, "blank costs < 3 points": lambda p: p["drop"] is not None and not looks(p),
+             "no blank flights": lambda p: p["drop"] is None}
+    for i, group in enumerate(groups):
+        colour = f"C{i}"
+        for kind, test in kinds.items():
+            mine = [p for p in points if p["group"] == group and test(p)]
+            style = {"looks": {"facecolors": colour}, "no blank flights": {"marker": "x", "c": colour}}.get(
+                kind, {"facecolors": "none", "edgecolors": colour})
+            ax.scatter([p["ratio"] for p in mine], [p["gain"] for p in mine], s=28,
+                       label=f"{group} ({kind})" if mine else None, **style)
+    for p in points:
+        if p["group"] == "baseline":
+            ax.plot(p["ratio"], p["gain"], "k*", markersize=10)
+            ax.annotate(p["name"], (p["ratio"], p["gain"]), textcoords="offset points", xytext=(5, 4),
+                        fontsize=8)
+    ax.axhline(MARGIN, color="grey", linestyle="--")
+    ax.axvline(METRES_BAR, color="grey", linestyle="--")
+    ax.set_xlim(0.9, max(2.0, min(4.2, max(p["ratio"] for p in points) + 0.1)))
+    ax.set_xlabel(f"metres over the tuned ring's (bar {METRES_BAR:g}x)")
+    ax.set_ylabel(f"coverage over the tuned ring, points (bar +{MARGIN:g})")
+    ax.set_title("Selection rounds on validation buildings: coverage against flight")
+    ax.legend(fontsize=7, loc="lower right")
+    return save_figure(fig, out)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--results", action="append", required=True, metavar="GROUP=PATH")
+    parser.add_argument("--exclude", nargs="*", default=[], help="planners left out (another setting's)")
+    parser.add_argument("--out", type=Path, required=True)
+    args = parser.parse_args()
+    files = [(group, json.loads(Path(path).read_text()))
+             for group, path in (item.split("=", 1) for item in args.results)]
+    points = frontier_points(files, tuple(args.exclude))
+    table = report(points)
+    with atomic_folder(args.out, overwrite=True, outputs=("frontier.md", "frontier.png")) as out:
+        write_text(out / "frontier.md", table + "\nCommand: `python scripts/selection_frontier.py "
+                   + " ".join(f'--results "{r}"' for r in args.results)
+                   + "".join(f" --exclude {name}" for name in args.exclude) + " --out OUT`\n")
+        plot(points, out / "frontier.png")
+    print(table)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

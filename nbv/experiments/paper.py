@@ -337,6 +337,9 @@ INDEX = (
            "round 19's near-tie setting over two more seeds, and a middle flight weight", LOOKS_EVAL),
     Result("selection/round21/README.md", "selection/round21/seed2/results.json", "its twenty-first round: "
            "the default setting over four more seeds, the checks counted by the script", LOOKS_EVAL),
+    Result("selection/round22/README.md", "selection/round22/hinge_seed1/results.json", "its twenty-second "
+           "round: a hinge on the flight term, longer training, and the frontier of coverage against metres",
+           LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

@@ -325,20 +325,17 @@ class RewardConfig:
 
     coverage: Annotated[float, arg(name="coverage-reward")] = 0.0
     """Weight W of a geometric reward term: W x the share of the target's surface samples that the new
-    view is the first of its episode to see (ground truth, so training only). 0: the Bag of Views reward
-    alone (the paper)."""
+    view is the first of its episode to see (ground truth: training only). 0: the paper's reward alone."""
 
     flight: Annotated[float, arg(name="flight-reward")] = 0.0
     """Weight W of a flight-cost term: minus W x the metres of the leg to the new view along the viewing
     shell (`nbv.flight.shell_path`), beyond the paper. 0: no flight cost."""
 
     flight_allowance: Annotated[float, arg(name="flight-allowance")] = 0.0
-    """Metres of an episode's flight free of `flight_excess` (`nbv.rl.flight_cost`: a hinge at a battery's
-    metres, so the flight below it is not traded against coverage). 0: the excess applies to every metre."""
+    """Metres of an episode's flight free of `flight_excess` (a hinge: `nbv.rl.flight_cost`). 0: none."""
 
     flight_excess: Annotated[float, arg(name="flight-excess-reward")] = 0.0
-    """Weight W of the hinge's term: minus W x the metres of a leg past `flight_allowance`, in the reward
-    and the teacher's scores alike. 0: the linear flight term alone."""
+    """Weight W of the hinge: minus W x each metre flown past `flight_allowance` (reward and teacher)."""
 
     imitation: Annotated[float, arg(name="imitation")] = 0.0
     """Weight W of an imitation term in the actor's loss (beyond the paper): W x the squared distance
@@ -362,18 +359,12 @@ class RewardConfig:
             raise ValueError(f"teacher_horizon must be >= 0, got {self.teacher_horizon}")
         if not 0 < self.teacher_discount <= 1:
             raise ValueError(f"teacher_discount must lie in (0, 1], got {self.teacher_discount}")
-        if not 0 <= self.teacher_tolerance < math.inf:
-            raise ValueError(f"teacher_tolerance must be finite and >= 0, got {self.teacher_tolerance}")
-        if not 0 <= self.imitation < math.inf:
-            raise ValueError(f"imitation must be finite and >= 0, got {self.imitation}")
-        if not 0 <= self.coverage < math.inf:
-            raise ValueError(f"coverage_reward must be finite and >= 0, got {self.coverage}")
-        if not 0 <= self.flight < math.inf:
-            raise ValueError(f"flight_reward must be finite and >= 0, got {self.flight}")
-        if not 0 <= self.flight_excess < math.inf:
-            raise ValueError(f"flight_excess_reward must be finite and >= 0, got {self.flight_excess}")
-        if not 0 <= self.flight_allowance < math.inf:
-            raise ValueError(f"flight_allowance must be finite and >= 0 metres, got {self.flight_allowance}")
+        for flag, value in (("teacher_tolerance", self.teacher_tolerance), ("imitation", self.imitation),
+                            ("coverage_reward", self.coverage), ("flight_reward", self.flight),
+                            ("flight_excess_reward", self.flight_excess),
+                            ("flight_allowance", self.flight_allowance)):
+            if not 0 <= value < math.inf:
+                raise ValueError(f"{flag} must be finite and >= 0, got {value}")
 
 
 @dataclass(frozen=True)

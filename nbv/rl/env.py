@@ -195,11 +195,8 @@ class NBVEnv(EnvBase):
         )
         self.action_spec = Bounded(-1.0, 1.0, shape=(3,), dtype=torch.float32)
         self.reward_spec = Unbounded(shape=(1,), dtype=torch.float32)
-        self.done_spec = Composite(
-            done=Categorical(2, shape=(1,), dtype=torch.bool),
-            terminated=Categorical(2, shape=(1,), dtype=torch.bool),
-            truncated=Categorical(2, shape=(1,), dtype=torch.bool),
-        )
+        self.done_spec = Composite({key: Categorical(2, shape=(1,), dtype=torch.bool)
+                                    for key in ("done", "terminated", "truncated")})
         self._scenes = config.scenes.specs()
         self._lattices: dict[str, ViewLattice] = {}
         self._visibility: dict[str, tuple[SurfaceVisibility, np.ndarray]] = {}  # with the scene centre
@@ -263,9 +260,8 @@ class NBVEnv(EnvBase):
             seen = self.surface_seen(view)
             reward += self.reward_terms.coverage * float((seen & ~self._seen).mean())
             self._seen |= seen
-        terms = self.reward_terms
-        if terms.flight or terms.flight_excess or self.config.bov_observation:
-            leg_m = shell_path(self._view, [view]).total_m
+        if self.reward_terms.flight or self.reward_terms.flight_excess or self.config.bov_observation:
+            leg_m, terms = shell_path(self._view, [view]).total_m, self.reward_terms
             reward -= flight_cost(terms.flight, self._metres, leg_m, terms.flight_allowance,
                                   terms.flight_excess)
             self._metres += leg_m

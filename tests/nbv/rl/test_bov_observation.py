@@ -136,7 +136,7 @@ def test_the_hinge_costs_only_the_metres_past_the_allowance():
     assert hinged[1] == pytest.approx(plain[1] - 4.0 * second / 2, abs=1e-5)
     with pytest.raises(ValueError, match="flight_excess_reward must be finite and >= 0"):
         RewardConfig(flight_excess=-1.0)
-    with pytest.raises(ValueError, match="flight_allowance must be finite and >= 0 metres"):
+    with pytest.raises(ValueError, match="flight_allowance must be finite and >= 0"):
         RewardConfig(flight_allowance=math.inf)
 
 

@@ -22,13 +22,11 @@ from pathlib import Path
 from matplotlib.figure import Figure
 
 from common.io import atomic_folder, markdown_table, write_text
-from nbv.experiments.online_acceptance import building_mean
+from nbv.experiments.online_acceptance import BLANK_DROP, FLIGHT_RATIO, ORBIT_MARGIN, building_mean
 from nbv.viz.figures import save_figure
 
 REFERENCE = "orbit"
 """The tuned single ring every gain and metres ratio is taken against."""
-MARGIN, METRES_BAR, LOOKS_BAR = 3.0, 1.5, 3.0
-"""Issue 26's bars: points over the ring, metres over the ring's, points lost with blank images."""
 BASELINES = ("orbit", "orbit2", "random")
 """Fixed planners, drawn once and labelled, not counted in a group."""
 
@@ -55,20 +53,24 @@ def frontier_points(files: list[tuple[str, dict]], exclude: tuple[str, ...] = ()
 
 
 def inside(point: dict) -> bool:
-    """Whether a point passes both the margin and the metres bar."""
-    return point["gain"] >= MARGIN and point["ratio"] <= METRES_BAR
+    """Whether a point passes both the margin and the metres bar (`nbv.experiments.online_acceptance`'s)."""
+    return point["gain"] >= ORBIT_MARGIN and point["ratio"] <= FLIGHT_RATIO
 
 
 def looks(point: dict) -> bool:
-    """Whether blank images cost the point's planner at least the looks bar."""
-    return point["drop"] is not None and point["drop"] >= LOOKS_BAR
+    """Whether blank images cost the point's planner at least the looks check's bar."""
+    return point["drop"] is not None and point["drop"] >= BLANK_DROP
+
+
+def groups_of(points: list[dict]) -> list[str]:
+    """The points' groups in their first order, the baselines left out."""
+    return list(dict.fromkeys(p["group"] for p in points if p["group"] != "baseline"))
 
 
 def report(points: list[dict]) -> str:
     """The groups' counts, then every point (markdown)."""
-    groups = list(dict.fromkeys(p["group"] for p in points if p["group"] != "baseline"))
     counts = []
-    for group in groups:
+    for group in groups_of(points):
         mine = [p for p in points if p["group"] == group]
         counts.append([group, len(mine), sum(map(inside, mine)), sum(map(looks, mine)),
                        sum(inside(p) and looks(p) for p in mine)])
@@ -76,8 +78,8 @@ def report(points: list[dict]) -> str:
              "-" if p["drop"] is None else f"{p['drop']:.1f}", "yes" if inside(p) else "no"] for p in points]
     head = ["group", "planner", "vs orbit", "metres", "blank drop", "inside"]
     return (f"Validation buildings, 13 views: mean coverage over the tuned ring (`{REFERENCE}`) and metres "
-            f"over its metres; inside: at least +{MARGIN:g} points within {METRES_BAR:g}x; looks: blank "
-            f"images cost at least {LOOKS_BAR:g} points.\n\n"
+            f"over its metres; inside: at least +{ORBIT_MARGIN:g} points within {FLIGHT_RATIO:g}x; looks: "
+            f"blank images cost at least {BLANK_DROP:g} points.\n\n"
             + markdown_table(["group", "actors", "inside both bars", "look", "inside and look"], counts)
             + "\n\n" + markdown_table(head, rows) + "\n")
 
@@ -87,27 +89,27 @@ def plot(points: list[dict], out: Path) -> Path:
     flights); the baselines starred; the bars dashed."""
     fig = Figure(figsize=(7.5, 5.0))
     ax = fig.subplots()
-    groups = list(dict.fromkeys(p["group"] for p in points if p["group"] != "baseline"))
-    kinds = {"looks": looks, "blank costs < 3 points": lambda p: p["drop"] is not None and not looks(p),
-             "no blank flights": lambda p: p["drop"] is None}
-    for i, group in enumerate(groups):
-        colour = f"C{i}"
-        for kind, test in kinds.items():
+    kinds = {  # what a point is, and how it is drawn in its group's colour
+        "looks": (looks, lambda colour: {"facecolors": colour}),
+        f"blank costs < {BLANK_DROP:g} points": (
+            lambda p: p["drop"] is not None and not looks(p),
+            lambda colour: {"facecolors": "none", "edgecolors": colour}),
+        "no blank flights": (lambda p: p["drop"] is None, lambda colour: {"marker": "x", "c": colour})}
+    for i, group in enumerate(groups_of(points)):
+        for kind, (test, style) in kinds.items():
             mine = [p for p in points if p["group"] == group and test(p)]
-            style = {"looks": {"facecolors": colour}, "no blank flights": {"marker": "x", "c": colour}}.get(
-                kind, {"facecolors": "none", "edgecolors": colour})
             ax.scatter([p["ratio"] for p in mine], [p["gain"] for p in mine], s=28,
-                       label=f"{group} ({kind})" if mine else None, **style)
+                       label=f"{group} ({kind})" if mine else None, **style(f"C{i}"))
     for p in points:
         if p["group"] == "baseline":
             ax.plot(p["ratio"], p["gain"], "k*", markersize=10)
             ax.annotate(p["name"], (p["ratio"], p["gain"]), textcoords="offset points", xytext=(5, 4),
                         fontsize=8)
-    ax.axhline(MARGIN, color="grey", linestyle="--")
-    ax.axvline(METRES_BAR, color="grey", linestyle="--")
+    ax.axhline(ORBIT_MARGIN, color="grey", linestyle="--")
+    ax.axvline(FLIGHT_RATIO, color="grey", linestyle="--")
     ax.set_xlim(0.9, max(2.0, min(4.2, max(p["ratio"] for p in points) + 0.1)))
-    ax.set_xlabel(f"metres over the tuned ring's (bar {METRES_BAR:g}x)")
-    ax.set_ylabel(f"coverage over the tuned ring, points (bar +{MARGIN:g})")
+    ax.set_xlabel(f"metres over the tuned ring's (bar {FLIGHT_RATIO:g}x)")
+    ax.set_ylabel(f"coverage over the tuned ring, points (bar +{ORBIT_MARGIN:g})")
     ax.set_title("Selection rounds on validation buildings: coverage against flight")
     ax.legend(fontsize=7, loc="lower right")
     return save_figure(fig, out)

@@ -89,7 +89,7 @@ def expert_scores(view: Viewpoint, seen: np.ndarray, sees: Callable[[Viewpoint],
             covered |= new
             flown.append(here)
         legs = shell_path(view, flown).legs_m
-        before = flown_m + np.concatenate([[0.0], np.cumsum(legs)[:-1]])
+        before = flown_m + np.cumsum([0.0, *legs[:-1]])  # the episode's metres as each leg starts
         cost = sum(discount ** k * (flight_cost(flight_weight, b, m, allowance_m, excess_weight)
                                     + TIE_BREAK_PER_M * m) for k, (b, m) in enumerate(zip(before, legs)))
         scores[i] = score - cost

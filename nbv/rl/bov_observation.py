@@ -17,7 +17,9 @@ through the Bag of Views, and the poses flown), so it is available at inference 
 - metres flown: the shell path's length so far (`nbv.flight.shell_path`) over one turn of the largest
   ring, 2 pi `radius_max`;
 - with `EnvConfig.look_map`, the map of where the episode has looked from (`nbv.rl.look_map`, its
-  `LOOK_MAP_SIZE` values), last.
+  `LOOK_MAP_SIZE` values);
+- with `EnvConfig.privileged_unseen` (a diagnostic that reads the true mesh, never shipped), the map of the
+  surface the episode has not seen (`nbv.rl.unseen_map`, its `UNSEEN_MAP_SIZE` values), last.
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ import numpy as np
 from nbv.bov.bag import BagOfViews
 from nbv.rl.config import EnvConfig
 from nbv.rl.look_map import LOOK_MAP_SIZE
+from nbv.rl.unseen_map import UNSEEN_MAP_SIZE
 
 BOV_KEY = "bov"
 """The state's key of the vector (absent when `EnvConfig.bov_observation` is off)."""
@@ -40,7 +43,8 @@ def bov_observation_size(config: EnvConfig) -> int:
     """Length of the vector for `config` (0 when the option is off: the paper's state)."""
     if not config.bov_observation:
         return 0
-    return 2 * config.bov.ranges * config.bov.elevation_bands + SCALARS + LOOK_MAP_SIZE * config.look_map
+    fills = 2 * config.bov.ranges * config.bov.elevation_bands
+    return fills + SCALARS + LOOK_MAP_SIZE * config.look_map + UNSEEN_MAP_SIZE * config.privileged_unseen
 
 
 def view_budget(config: EnvConfig) -> int:
@@ -49,16 +53,20 @@ def view_budget(config: EnvConfig) -> int:
 
 
 def bov_vector(bov: BagOfViews, novelty: float, views: int, metres: float, config: EnvConfig,
-               looked: np.ndarray | None = None) -> np.ndarray:
+               looked: np.ndarray | None = None, unseen: np.ndarray | None = None) -> np.ndarray:
     """The vector (float32, `bov_observation_size(config)`) after `views` views, `metres` flown, the last
-    view's novelty `novelty` (`novelty_of`) and, with `config.look_map`, the look map `looked`."""
-    if config.look_map and looked is None:
-        raise ValueError("config.look_map is on: bov_vector needs the look map")
+    view's novelty `novelty` (`novelty_of`), with `config.look_map` the look map `looked` and with
+    `config.privileged_unseen` the unseen map `unseen`."""
+    for name, on, given in (("look_map", config.look_map, looked), ("privileged_unseen",
+                                                                     config.privileged_unseen, unseen)):
+        if on and given is None:
+            raise ValueError(f"config.{name} is on: bov_vector needs its map")
     words = bov.word_count.double().numpy() / bov.num_words
     memory = bov.memory_count.double().numpy() / bov.memory_cap
     budget = view_budget(config)
     scalars = [novelty, (budget - views) / budget, metres / (2.0 * math.pi * config.radius_max)]
-    parts = [words, memory, scalars] + ([looked] if config.look_map else [])
+    parts = [words, memory, scalars] + ([looked] if config.look_map else []) + (
+        [unseen] if config.privileged_unseen else [])
     return np.concatenate(parts).astype(np.float32)
 
 

@@ -1,14 +1,12 @@
 """Configs of the RL problem and of `nbv train`, grouped by concern (TorchRL sota-implementations/sac).
 
-Light on purpose (no torch, no torchrl): the command line builds its parser
-from these classes. `TrainConfig` nests the env (itself nesting the scene
-set, camera, render settings and Bag of Views) and one group per training
-concern. Defaults follow the paper's Table 1 (batch 8, learning rate 5e-4,
-fixed temperature alpha 0.2, target networks soft-updated by 0.01 every 20
-gradient steps, replay buffer of 1e6 transitions, discount 0.99).
-Training-only reward terms, which read the true mesh, are `TrainConfig`'s
-`reward` group, not the env's: an env rebuilt from a trained run's
-`EnvConfig` (planning, validation, scoring) cannot inherit them.
+Light on purpose (no torch, no torchrl): the command line builds its parser from these classes.
+`TrainConfig` nests the env (itself nesting the scene set, camera, render settings and Bag of Views) and one
+group per training concern. Defaults follow the paper's Table 1 (batch 8, learning rate 5e-4, fixed
+temperature alpha 0.2, target networks soft-updated by 0.01 every 20 gradient steps, replay buffer of 1e6
+transitions, discount 0.99). Training-only reward terms, which read the true mesh, are `TrainConfig`'s
+`reward` group, not the env's: an env rebuilt from a trained run's `EnvConfig` (planning, validation,
+scoring) cannot inherit them (the one state input that reads it, `privileged_unseen`, is a diagnostic).
 """
 
 from __future__ import annotations
@@ -104,6 +102,8 @@ class EnvConfig:
     """Beyond the paper, with `bov_observation`: the `bov` vector ends in a map of the directions the
     episode has looked from, from the poses flown alone (`nbv.rl.look_map`): a memory blank images do not
     empty."""
+    privileged_unseen: bool = False
+    """A diagnostic, never shipped: the `bov` vector ends in the true unseen surface (`nbv.rl.unseen_map`)."""
     pose_observation: bool = True
     """The state's `viewpoints` (the paper's). Off (beyond the paper): they are zeros, so the networks must
     read where the camera is from the frames (and the Bag of Views vector): a test of whether a policy that
@@ -117,8 +117,9 @@ class EnvConfig:
         if not -90 < self.elevation_min_deg <= self.elevation_max_deg < 90:
             raise ValueError("need -90 < elevation_min_deg <= elevation_max_deg < 90, got "
                              f"{self.elevation_min_deg}, {self.elevation_max_deg}")
-        if self.look_map and not self.bov_observation:
-            raise ValueError("look_map extends the Bag of Views vector: it needs bov_observation")
+        for name in ("look_map", "privileged_unseen"):
+            if getattr(self, name) and not self.bov_observation:
+                raise ValueError(f"{name} extends the Bag of Views vector: it needs bov_observation")
         for name in ("obs_size", "history", "max_steps"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
@@ -338,10 +339,9 @@ class RewardConfig:
     """Weight W of the hinge: minus W x each metre flown past `flight_allowance` (reward and teacher)."""
 
     imitation: Annotated[float, arg(name="imitation")] = 0.0
-    """Weight W of an imitation term in the actor's loss (beyond the paper): W x the squared distance
-    between the actor's mode and the privileged teacher's action (`nbv.rl.expert`: the candidate step that
-    sees the most true surface not seen yet, less the flight term), labelled in every state the training
-    env visits. 0: SAC alone."""
+    """Weight W of an imitation term in the actor's loss (beyond the paper): W x the squared distance between
+    the actor's mode and the privileged teacher's action (`nbv.rl.expert`: the candidate step that sees the
+    most true surface not seen yet, less the flight term), labelled in every state the training env visits."""
 
     teacher_horizon: Annotated[int, arg(name="teacher-horizon")] = 3
     """How many times over the teacher flies each candidate action to score it (`nbv.rl.expert`); 0: to the

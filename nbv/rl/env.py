@@ -1,65 +1,52 @@
 """The online next-best-view problem as a TorchRL environment (paper Sec. IV; docs/rl.md).
 
-State: the last `history` (tau = 5) grayscale frames, downsampled to
-`obs_size` x `obs_size` (uint8, key `pixels`), and the last `history`
-viewpoints (R, azimuth, elevation), each normalised to [-1, 1] over its allowed
-range (key `viewpoints`; zeros with `pose_observation` off). At reset both
-histories hold copies of the first view.
+State: the last `history` (tau = 5) grayscale frames, downsampled to `obs_size` x `obs_size` (uint8, key
+`pixels`), and the last `history` viewpoints (R, azimuth, elevation), each normalised to [-1, 1] over its
+allowed range (key `viewpoints`; zeros with `pose_observation` off). At reset both histories hold copies of
+the first view. With `bov_observation`, the `bov` vector (`nbv.rl.bov_observation`); with the diagnostic
+`privileged_unseen`, the env tracks the episode's seen surface samples to end it in their unseen map.
 
-Action: three values in [-1, 1]. In the paper's `absolute` mode they are the
-next viewpoint itself, rescaled to the allowed ranges of R, azimuth and
-elevation ("rescaled to conform to the specified ranges", Sec. IV); in the
-`relative` mode they are a step from the current viewpoint, at most
-`relative_step` of each range, clipped to the ranges; in the `orbit` mode
-the azimuth is such a step and R and elevation are absolute; in the `forward`
-mode (beyond the paper) R and elevation are absolute and the azimuth always
-advances, by half to all of `relative_step` of a turn, as a pilot's orbit
-does (no hovering, no turning back). Orbit exists
-because absolute azimuth is a circular target that a tanh output cannot
-follow across 0 = 2 pi (moving on by 45 degrees from 350 needs an action
-jump from +1 to -1), and it keeps R and elevation free of the drift of
-relative steps (measured, with unscaled rewards: a relative policy flew
-every view at R = 1.5 m, 5 degrees up; on the held-out chalet those close,
-low views happened to cover the surface best, see paper_results/planners).
+Action: three values in [-1, 1]. In the paper's `absolute` mode they are the next viewpoint itself,
+rescaled to the allowed ranges of R, azimuth and elevation ("rescaled to conform to the specified ranges",
+Sec. IV); in the `relative` mode they are a step from the current viewpoint, at most `relative_step` of
+each range, clipped to the ranges; in the `orbit` mode the azimuth is such a step and R and elevation are
+absolute; in the `forward` mode (beyond the paper) R and elevation are absolute and the azimuth always
+advances, by half to all of `relative_step` of a turn, as a pilot's orbit does (no hovering, no turning
+back). Orbit exists because absolute azimuth is a circular target that a tanh output cannot follow across
+0 = 2 pi (moving on by 45 degrees from 350 needs an action jump from +1 to -1), and it keeps R and
+elevation free of the drift of relative steps (measured, with unscaled rewards: a relative policy flew
+every view at R = 1.5 m, 5 degrees up; on the held-out chalet those close, low views happened to cover the
+surface best, see paper_results/planners).
 
-Reward: the Bag of Views reward of the new view (vocabulary change - 1,
-docs/bov.md), from the config's `bov` (its match cosine included; with
-`elevation_bands` E > 1 each azimuth range is split into E bands over the
-allowed elevations, beyond the paper). The BoV is
-emptied at each reset and learns the episode's first view without reward.
-With training-only `reward_terms` (`RewardConfig`, given by the training builders
-alone) of coverage weight W > 0 (beyond the paper: it reads the true mesh) the
-reward adds W x the share of the target's surface samples
-(`nbv.recon.visibility`) that the new view is the episode's first to see; on
-a lattice that is the node's view, as the frame is. With an imitation weight
-> 0 (`RewardConfig.imitation`) every state also holds the privileged teacher's
-action (`expert_action`, `nbv.rl.expert`), and with a `teacher_tolerance` its
-near-ties (`expert_near_best`), which the actor never reads: the SAC update
-pulls the actor's mode towards them.
+Reward: the Bag of Views reward of the new view (vocabulary change - 1, docs/bov.md), from the config's `bov`
+(its match cosine included; with `elevation_bands` E > 1 each azimuth range is split into E bands over the
+allowed elevations, beyond the paper). The BoV is emptied at each reset and learns the episode's first view
+without reward. With training-only `reward_terms` (`RewardConfig`, given by the training builders alone) of
+coverage weight W > 0 (beyond the paper: it reads the true mesh) the reward adds W x the share of the target's
+surface samples (`nbv.recon.visibility`) that the new view is the episode's first to see; on a lattice that is
+the node's view, as the frame is. With an imitation weight > 0 (`RewardConfig.imitation`) every state also
+holds the privileged teacher's action (`expert_action`, `nbv.rl.expert`), and with a `teacher_tolerance` its
+near-ties (`expert_near_best`), which the actor never reads: the SAC update pulls the actor's mode towards
+them.
 
-Termination: one pass around the target, i.e. the net azimuth travelled
-(each step's change wrapped to (-pi, pi]) reaches 2 pi in either direction;
-or, with `episode_views` N > 0 (a fixed view budget, beyond the paper), the
-N-th view, and passes do not end it. Truncation: `max_steps` steps.
+Termination: one pass around the target, i.e. the net azimuth travelled (each step's change wrapped to
+(-pi, pi]) reaches 2 pi in either direction; or, with `episode_views` N > 0 (a fixed view budget, beyond the
+paper), the N-th view, and passes do not end it. Truncation: `max_steps` steps.
 
-Lattice (training): the env's viewpoint stays the exact one the actions lead
-to (steps accumulate, and the state records it); only the frame and the
-descriptors come from the nearest lattice node. Snapping the viewpoint itself
-kept relative steps smaller than half a node spacing from ever moving the
-camera (R never changed, elevation only at |action| > 0.8), so policies
-trained that way flew one ring at their start elevation.
+Lattice (training): the env's viewpoint stays the exact one the actions lead to (steps accumulate, and the
+state records it); only the frame and the descriptors come from the nearest lattice node. Snapping the
+viewpoint itself kept relative steps smaller than half a node spacing from ever moving the camera (R never
+changed, elevation only at |action| > 0.8), so policies trained that way flew one ring at their start
+elevation.
 
-Rendering: through a view source (`nbv.features.source.ViewSource`, the one
-the planners and the validator use too): one renderer per scene (loaded with
-the scene set's up axis), created lazily on the first reset, in the process
-that steps the env, so `ParallelEnv`'s spawned workers each choose their own
-Mitsuba variant; view k is rendered with the config's render settings'
-`view_seed(k)` under the env's seed. `render_depth` gives the z-depth a depth
-camera returns at a view, timed apart from the RGB renders. The constructor
-takes only picklable settings (or a view source to share). Before the first view is
-rendered the process's torch threads follow the thread policy
-(`common.threads.apply_thread_policy`: 1 unless the process chose otherwise),
-since the renderer and Kornia SIFT share the cores with everything else.
+Rendering: through a view source (`nbv.features.source.ViewSource`, the one the planners and the validator use
+too): one renderer per scene (loaded with the scene set's up axis), created lazily on the first reset, in the
+process that steps the env, so `ParallelEnv`'s spawned workers each choose their own Mitsuba variant; view k
+is rendered with the config's render settings' `view_seed(k)` under the env's seed. `render_depth` gives the
+z-depth a depth camera returns at a view, timed apart from the RGB renders. The constructor takes only
+picklable settings (or a view source to share). Before the first view is rendered the process's torch threads
+follow the thread policy (`common.threads.apply_thread_policy`: 1 unless the process chose otherwise), since
+the renderer and Kornia SIFT share the cores with everything else.
 """
 
 from __future__ import annotations
@@ -95,6 +82,7 @@ from nbv.rl.expert import (
 from nbv.rl.flight_cost import flight_cost
 from nbv.rl.lattice import ViewLattice, build_lattice
 from nbv.rl.look_map import look_of
+from nbv.rl.unseen_map import sample_bins, unseen_map
 from render.viewpoint import TWO_PI, Viewpoint, draw_viewpoint, viewpoint_to_c2w
 from scenes.model import Scene
 from scenes.spec import SceneSpec
@@ -182,6 +170,7 @@ class NBVEnv(EnvBase):
         self.reward_terms = reward_terms
         self.worker = worker
         self.blank_images = blank_images
+        self._tracks_seen = bool(reward_terms.coverage or reward_terms.imitation or config.privileged_unseen)
         tau, side = config.history, config.obs_size
         extra = {BOV_KEY: Unbounded(shape=(bov_observation_size(config),), dtype=torch.float32)
                  } if config.bov_observation else {}
@@ -199,7 +188,7 @@ class NBVEnv(EnvBase):
                                     for key in ("done", "terminated", "truncated")})
         self._scenes = config.scenes.specs()
         self._lattices: dict[str, ViewLattice] = {}
-        self._visibility: dict[str, tuple[SurfaceVisibility, np.ndarray]] = {}  # with the scene centre
+        self._visibility: dict[str, tuple[SurfaceVisibility, np.ndarray, np.ndarray]] = {}  # centre, bins
         self._node_seen: dict[tuple[str, int], np.ndarray] = {}
         self._seen: np.ndarray | None = None  # the episode's seen surface samples (coverage reward)
         self._features = config.bov.feature_config()
@@ -242,7 +231,7 @@ class NBVEnv(EnvBase):
             self.bov.update(descriptors, self._view.azimuth, self._view.elevation)
         self._metres = 0.0
         self._looked = look_of(self._view) if self.config.look_map else None
-        if self.reward_terms.coverage or self.reward_terms.imitation:
+        if self._tracks_seen:
             self._seen = self.surface_seen(self._view).copy()  # ours to grow: the node's cache stays as is
         location = normalise_viewpoint(self._view, self.config)
         self._frames = np.repeat(frame[None], self.config.history, axis=0)
@@ -256,7 +245,7 @@ class NBVEnv(EnvBase):
         view = action_to_viewpoint(tensordict["action"], self._view, self.config)
         frame, descriptors = self.capture(view)
         reward = bov_reward = self.bov.reward(descriptors, view.azimuth, view.elevation)
-        if self.reward_terms.coverage or self.reward_terms.imitation:
+        if self._tracks_seen:
             seen = self.surface_seen(view)
             reward += self.reward_terms.coverage * float((seen & ~self._seen).mean())
             self._seen |= seen
@@ -394,8 +383,9 @@ class NBVEnv(EnvBase):
         read-only array cached per node)."""
         scene = self._scene.scene
         if scene not in self._visibility:
-            self._visibility[scene] = scene_visibility(self.scene, self.config.camera), self.scene.center()
-        visibility, center = self._visibility[scene]
+            visibility, center = scene_visibility(self.scene, self.config.camera), self.scene.center()
+            self._visibility[scene] = visibility, center, sample_bins(visibility.samples, center)
+        visibility, center, _ = self._visibility[scene]
         if not self.config.lattice.enabled:
             return visibility.seen(viewpoint_to_c2w(view, center))
         node, index = self._lattice(self._scene).snap(view)
@@ -435,8 +425,10 @@ class NBVEnv(EnvBase):
         return self._lattices[spec.scene]
 
     def _observation(self, terminated: bool = False, truncated: bool = False) -> TensorDict:
+        bins = self._visibility[self._scene.scene][2] if self.config.privileged_unseen else None
+        unseen = None if bins is None else unseen_map(bins, self._seen)
         extra = {BOV_KEY: torch.from_numpy(bov_vector(self.bov, self._novelty, self._steps + 1, self._metres,
-                                                      self.config, self._looked))
+                                                      self.config, self._looked, unseen))
                  } if self.config.bov_observation else {}
         return TensorDict({
             "pixels": torch.from_numpy(self._frames.copy()),

@@ -88,8 +88,11 @@ def export_run(run: Path, dest: Path, name: str) -> None:
     actor and config, `weights_only`-loadable), config.json, training.png and logs (metrics.csv and, when
     validated, validation.csv); for a run of several members, members.csv and each member's config.json
     and logs in memberK/. The run folder in the recorded configs becomes `name` (a relative path), so no
-    machine path is written; nothing else changes."""
+    machine path is written; nothing else changes. A policy that reads the true mesh (`privileged_unseen`)
+    cannot fly a real building: refused."""
     config, _ = load_policy(run / POLICY)
+    if config["env"].get("privileged_unseen"):
+        raise ValueError(f"{run / POLICY} reads the true mesh (privileged_unseen): never shipped")
     config["logger"]["out"] = name
     dest.mkdir(parents=True, exist_ok=True)
     copy_policy(run / POLICY, dest / POLICY, config)

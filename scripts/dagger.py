@@ -14,6 +14,11 @@ passes). The loss on newly flown states before fitting them is the student's err
 the loss on the held states is its error on states it never fitted. No reward, no critic: the question
 is whether the images and poses carry what the teacher knows, given enough updates.
 
+With `--privileged-unseen` the actor also reads the true surface's unseen map (`nbv.rl.unseen_map`, a
+diagnostic), as the buffers of runs trained with it hold; `--strip-unseen` fits the actor without it to
+such buffers' states, the map cut from each: the same states and labels, with and without the teacher's
+knowledge (round 23).
+
 Writes OUT/policy.pt (a policy file `nbv plan --planner policy:OUT/policy.pt` and `scripts/looks_eval.py`
 read), OUT/dagger.json (per iteration: states, on-policy loss, fitted loss) and OUT/config.json. The
 training env is `nbv train --preset PRESET --scene ...`'s (default: the default preset's buildings):
@@ -41,12 +46,14 @@ from tqdm import tqdm
 from common.io import write_json
 from common.provenance import config_record, git_commit, portable_record
 from common.threads import set_torch_threads
+from nbv.rl.bov_observation import BOV_KEY
 from nbv.rl.builders import make_environment, make_loss_module, make_sac_agent
 from nbv.rl.checkpoint import save_policy
 from nbv.rl.config import TrainConfig
 from nbv.rl.expert import EXPERT_KEY, label_keys
 from nbv.rl.presets import PRESETS
 from nbv.rl.train import mode_distance
+from nbv.rl.unseen_map import UNSEEN_MAP_SIZE
 from scenes.spec import SceneSet
 
 
@@ -89,13 +96,19 @@ def seed_states(buffers: list[Path], keys: list[str], share: float,
     return [pooled[i] for i in order[cut:]], held
 
 
-def train_config(preset: str, scenes: list[str], out: Path) -> TrainConfig:
-    """`nbv train --preset PRESET [--scene S ...] --out OUT`'s config (the given scenes replace the
-    preset's), built from the presets themselves: a script does not import the command line."""
+def train_config(preset: str, scenes: list[str], out: Path, privileged: bool = False) -> TrainConfig:
+    """`nbv train --preset PRESET [--scene S ...] [--privileged-unseen] --out OUT`'s config (the given scenes
+    replace the preset's), built from the presets themselves: a script does not import the command line."""
     config = PRESETS[preset]()
+    config = replace(config, env=replace(config.env, privileged_unseen=privileged))
     if scenes:
         config = replace(config, env=replace(config.env, scenes=SceneSet(scene=tuple(scenes))))
     return replace(config, logger=replace(config.logger, out=out))
+
+
+def strip_unseen(states: TensorDict) -> TensorDict:
+    """The state(s) with the unseen map cut from the end of the Bag of Views vector (in place)."""
+    return states.set(BOV_KEY, states[BOV_KEY][..., :-UNSEEN_MAP_SIZE])
 
 
 def fit(actor, optimiser, data: TensorDict, held: TensorDict | None, epochs: int, batch: int,
@@ -130,10 +143,15 @@ def main(argv: list[str]) -> int:
                         help="training checkpoints whose replay buffers' labelled states seed the pool")
     parser.add_argument("--held", type=float, default=0.1, help="share of the seed states never fitted")
     parser.add_argument("--preset", choices=tuple(PRESETS), default="default", help="nbv train's preset")
+    parser.add_argument("--privileged-unseen", action="store_true", help="the actor reads the unseen map")
+    parser.add_argument("--strip-unseen", action="store_true", help="cut the unseen map from the buffers' "
+                        "states (buffers of a --privileged-unseen run, fitted without it)")
     parser.add_argument("--scene", action="append", default=[], help="a training building (repeat; "
                         "given ones replace the preset's, as with nbv train)")
     args = parser.parse_args(argv)
-    config = train_config(args.preset, args.scene, args.out)
+    if args.privileged_unseen and args.strip_unseen:
+        raise SystemExit("--strip-unseen fits an actor without the unseen map: not with --privileged-unseen")
+    config = train_config(args.preset, args.scene, args.out, args.privileged_unseen)
     if config.reward.imitation <= 0:
         raise SystemExit("the training env labels states with the teacher only with --imitation > 0")
     args.out.mkdir(parents=True, exist_ok=True)
@@ -146,6 +164,9 @@ def main(argv: list[str]) -> int:
     generator = torch.Generator().manual_seed(args.seed)
     keys = [*actor.in_keys, *label_keys(config.reward)]
     pooled, held = seed_states(args.buffers, keys, args.held, generator)
+    if args.strip_unseen and pooled:
+        pooled = [strip_unseen(state) for state in pooled]
+        held = None if held is None else strip_unseen(held)
     log = []
     start = time.perf_counter()
     if pooled:

@@ -66,3 +66,13 @@ def test_its_training_config_is_nbv_trains_for_the_same_preset_and_buildings(tmp
     assert config_record(made) == config_record(parse_train([*flags, "--out", str(tmp_path)]))
     assert config_record(dagger().train_config("paper", [], tmp_path)) == config_record(
         parse_train(["--preset", "paper", "--out", str(tmp_path)]))
+    assert config_record(dagger().train_config("default", [], tmp_path, privileged=True)) == config_record(
+        parse_train(["--privileged-unseen", "--out", str(tmp_path)]))
+
+
+def test_strip_unseen_cuts_the_map_from_one_state_and_from_a_stack():
+    module = dagger()
+    one = TensorDict({"bov": torch.arange(40.0)}, [])
+    assert module.strip_unseen(one)["bov"].tolist() == list(range(4))
+    stack = TensorDict({"bov": torch.ones(3, 40)}, [3])
+    assert module.strip_unseen(stack)["bov"].shape == (3, 4)

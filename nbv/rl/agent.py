@@ -76,14 +76,20 @@ class ActorNet(nn.Module):
             nn.Linear(config.location_hidden, h), nn.ReLU())
         self.head = nn.Sequential(nn.Linear(2 * h, h), nn.ReLU(), nn.Linear(h, 6), NormalParamExtractor())
 
-    def forward(self, pixels: torch.Tensor, viewpoints: torch.Tensor,
-                bov: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
+    def features(self, pixels: torch.Tensor, viewpoints: torch.Tensor,
+                 bov: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Size]:
+        """The fused observation and location features (B, 2 x hidden), B the flattened leading dimensions
+        (returned): what the head reads."""
         locations, batch = _flatten_batch(viewpoints, 2)
         if self.observation is None:
             observed = _flatten_batch(bov, 1)[0]
         else:
             observed = _with_extra(self.observation(_flatten_batch(pixels.float() / 255.0, 3)[0]), bov)
-        features = torch.cat([self.observation_fc(observed), self.location(locations.flatten(1))], dim=-1)
+        return torch.cat([self.observation_fc(observed), self.location(locations.flatten(1))], dim=-1), batch
+
+    def forward(self, pixels: torch.Tensor, viewpoints: torch.Tensor,
+                bov: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
+        features, batch = self.features(pixels, viewpoints, bov)
         loc, scale = self.head(features)
         return loc.reshape(*batch, 3), scale.reshape(*batch, 3)
 

@@ -381,19 +381,24 @@ class NBVEnv(EnvBase):
     def surface_seen(self, view: Viewpoint) -> np.ndarray:
         """Which of the current target's surface samples `view` sees (with a lattice: its node does, a
         read-only array cached per node)."""
-        scene = self._scene.scene
-        if scene not in self._visibility:
-            visibility, center = scene_visibility(self.scene, self.config.camera), self.scene.center()
-            self._visibility[scene] = visibility, center, sample_bins(visibility.samples, center)
-        visibility, center, _ = self._visibility[scene]
+        visibility, center, _ = self._target_samples()
         if not self.config.lattice.enabled:
             return visibility.seen(viewpoint_to_c2w(view, center))
         node, index = self._lattice(self._scene).snap(view)
+        scene = self._scene.scene
         if (scene, index) not in self._node_seen:
             seen = visibility.seen(viewpoint_to_c2w(node, center))
             seen.setflags(write=False)  # shared by every episode that visits the node: never grown in place
             self._node_seen[scene, index] = seen
         return self._node_seen[scene, index]
+
+    def _target_samples(self) -> tuple[SurfaceVisibility, np.ndarray, np.ndarray]:
+        """The current target's surface visibility, centre and samples' unseen-map bins (on first use)."""
+        scene = self._scene.scene
+        if scene not in self._visibility:
+            visibility, center = scene_visibility(self.scene, self.config.camera), self.scene.center()
+            self._visibility[scene] = visibility, center, sample_bins(visibility.samples, center)
+        return self._visibility[scene]
 
     def expert_scores(self) -> np.ndarray:
         """The privileged teacher's scores of its candidate steps from the current view (`nbv.rl.expert`):
@@ -425,8 +430,7 @@ class NBVEnv(EnvBase):
         return self._lattices[spec.scene]
 
     def _observation(self, terminated: bool = False, truncated: bool = False) -> TensorDict:
-        bins = self._visibility[self._scene.scene][2] if self.config.privileged_unseen else None
-        unseen = None if bins is None else unseen_map(bins, self._seen)
+        unseen = unseen_map(self._target_samples()[2], self._seen) if self.config.privileged_unseen else None
         extra = {BOV_KEY: torch.from_numpy(bov_vector(self.bov, self._novelty, self._steps + 1, self._metres,
                                                       self.config, self._looked, unseen))
                  } if self.config.bov_observation else {}

@@ -69,3 +69,12 @@ def test_a_policy_that_reads_the_true_mesh_never_ships(tmp_path):
     with pytest.raises(ValueError, match="reads the true mesh"):
         export_run(tmp_path, tmp_path / "shipped", "runs/default")
     assert not (tmp_path / "shipped").exists()
+
+
+def test_a_resumed_episode_carries_the_map():
+    env = NBVEnv(config(bov_observation=True, privileged_unseen=True), seed=5)
+    env.reset()
+    env.step(TensorDict({"action": torch.tensor(ACTIONS[1])}, []))
+    again = NBVEnv(config(bov_observation=True, privileged_unseen=True), seed=0)
+    again.restore(env.snapshot())  # a new env: no samples loaded yet when the resumed state is read
+    np.testing.assert_array_equal(again.reset()[BOV_KEY], env._observation()[BOV_KEY])

@@ -130,7 +130,8 @@ def fit(actor, optimiser, data: TensorDict, held: TensorDict | None, epochs: int
     return passes
 
 
-def main(argv: list[str]) -> int:
+def arguments(argv: list[str]) -> argparse.Namespace:
+    """The command line (module docstring)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, required=True)
     parser.add_argument("--iterations", type=int, default=4)
@@ -151,6 +152,11 @@ def main(argv: list[str]) -> int:
     args = parser.parse_args(argv)
     if args.privileged_unseen and args.strip_unseen:
         raise SystemExit("--strip-unseen fits an actor without the unseen map: not with --privileged-unseen")
+    return args
+
+
+def main(argv: list[str]) -> int:
+    args = arguments(argv)
     config = train_config(args.preset, args.scene, args.out, args.privileged_unseen)
     if config.reward.imitation <= 0:
         raise SystemExit("the training env labels states with the teacher only with --imitation > 0")

@@ -6,6 +6,7 @@ import importlib.util
 from collections import OrderedDict
 from pathlib import Path
 
+import pytest
 import torch
 from tensordict import TensorDict
 
@@ -76,3 +77,8 @@ def test_strip_unseen_cuts_the_map_from_one_state_and_from_a_stack():
     assert module.strip_unseen(one)["bov"].tolist() == list(range(4))
     stack = TensorDict({"bov": torch.ones(3, 40)}, [3])
     assert module.strip_unseen(stack)["bov"].shape == (3, 4)
+
+
+def test_the_map_cannot_be_both_read_and_cut():
+    with pytest.raises(SystemExit, match="--strip-unseen fits an actor without the unseen map"):
+        dagger().arguments(["--out", "x", "--privileged-unseen", "--strip-unseen"])

@@ -340,6 +340,9 @@ INDEX = (
     Result("selection/round22/README.md", "selection/round22/hinge_seed1/results.json", "its twenty-second "
            "round: a hinge on the flight term, longer training, and the frontier of coverage against metres",
            LOOKS_EVAL),
+    Result("selection/round23/README.md", "selection/round23/privileged_seed1/results.json", "its "
+           "twenty-third round: the teacher's knowledge in the student's state, and a student that ranks the "
+           "teacher's steps", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

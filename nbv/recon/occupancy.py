@@ -90,6 +90,12 @@ class OccupancyGrid:
     def gain(self, K: np.ndarray, c2w: np.ndarray, width: int, height: int,  # noqa: N803
              stride: int = 1) -> int:
         """Distinct unknown voxels that every `stride`-th pixel's ray reaches before an occupied voxel."""
+        return int(self.reached(K, c2w, width, height, stride).sum())
+
+    def reached(self, K: np.ndarray, c2w: np.ndarray, width: int, height: int,  # noqa: N803
+                stride: int = 1) -> np.ndarray:
+        """Which voxels (flat bool, the grid's size) are unknown and reached by every `stride`-th pixel's ray
+        before an occupied voxel: the voxels `gain` counts."""
         origin, rays = self._rays(K, c2w, width, height)
         rays = rays[::stride, ::stride].reshape(-1, 3)
         flat = self.state.reshape(-1)
@@ -99,7 +105,7 @@ class OccupancyGrid:
             state = flat[index]
             blocked = np.logical_or.accumulate(valid & (state == OCCUPIED), axis=1)
             reached[index[valid & ~blocked & (state == UNKNOWN)]] = True
-        return int(reached.sum())
+        return reached
 
     def contains(self, points: np.ndarray) -> np.ndarray:
         """(N,) True where a point lies inside the grid's box."""

@@ -53,6 +53,13 @@ def test_gain_counts_the_unknown_voxels_a_view_reaches_before_an_occupied_one():
     assert grid.gain(ONE_PIXEL, AGAINST_X, 1, 1) == 0
 
 
+def test_reached_names_the_voxels_gain_counts():
+    grid = row_of_four()
+    assert grid.reached(ONE_PIXEL, ALONG_X, 1, 1).tolist() == [True] * 4
+    grid.integrate(np.array([[3.5]], np.float32), ONE_PIXEL, ALONG_X)
+    assert grid.reached(ONE_PIXEL, AGAINST_X, 1, 1).tolist() == [False, False, False, True]  # voxel 3 only
+
+
 def test_a_ray_that_misses_the_grid_gains_nothing_and_changes_nothing():
     grid = row_of_four()
     away = AGAINST_X.copy()

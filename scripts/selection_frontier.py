@@ -107,7 +107,8 @@ def plot(points: list[dict], out: Path) -> Path:
                         fontsize=8)
     ax.axhline(ORBIT_MARGIN, color="grey", linestyle="--")
     ax.axvline(FLIGHT_RATIO, color="grey", linestyle="--")
-    ax.set_xlim(0.9, max(2.0, min(4.2, max(p["ratio"] for p in points) + 0.1)))
+    ratios = [p["ratio"] for p in points]
+    ax.set_xlim(min(0.9, min(ratios) - 0.05), max(2.0, min(4.2, max(ratios) + 0.1)))
     ax.set_xlabel(f"metres over the tuned ring's (bar {FLIGHT_RATIO:g}x)")
     ax.set_ylabel(f"coverage over the tuned ring, points (bar +{ORBIT_MARGIN:g})")
     ax.set_title("Selection rounds on validation buildings: coverage against flight")

@@ -22,8 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from common.io import atomic_folder, write_json, write_text
-from common.provenance import git_commit, portable_record
+from common.io import atomic_folder
 from nbv.flight.path import shell_path
 from nbv.planning.base import Planner
 from nbv.planning.config import PlanSettings
@@ -35,11 +34,10 @@ from nbv.rl.config import EnvConfig
 from nbv.rl.env import action_to_viewpoint
 from nbv.rl.expert import best_action, expert_scores
 from nbv.rl.presets import default_preset
-from nbv.viz.figures import plot_seed_scores
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 
 sys.path.insert(0, str(Path(__file__).parent))
-from looks_eval import evaluate, policy_acceptance, refuse_held_out, report, study_arguments  # noqa: E402
+import looks_eval  # noqa: E402
 
 
 class DepthTeacherPlanner(Planner):
@@ -83,9 +81,9 @@ def main() -> None:
     parser.add_argument("--teacher-discount", type=float, default=0.9)
     parser.add_argument("--grid-resolution", type=int, default=32, help="voxels along the longest side")
     parser.add_argument("--gain-ray-stride", type=int, default=8, help="every n-th pixel's ray, both axes")
-    study_arguments(parser)
+    looks_eval.study_arguments(parser)
     args = parser.parse_args()
-    refuse_held_out(args.scenes)
+    looks_eval.refuse_held_out(args.scenes)
     trained = default_preset().env
     grid = OccupancyConfig(grid_resolution=args.grid_resolution, gain_ray_stride=args.gain_ray_stride)
     planners = {name: (make_planner(name, PlanSettings()), False) for name in ("orbit", "orbit2", "random")}
@@ -95,18 +93,12 @@ def main() -> None:
         planners[name] = (DepthTeacherPlanner(trained, grid, w, args.teacher_horizon, args.teacher_discount),
                           False)
         names.append(name)
-    results = evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work)
-    checks = policy_acceptance(results, args.scenes, names)
-    table = report(results, args.scenes, args.seeds, args.views, "orbit", checks)
-    outputs = ("results.json", "results.md", "coverage.png")
-    with atomic_folder(args.out, overwrite=True, outputs=outputs) as out:
-        write_text(out / "results.md", table)
-        plot_seed_scores({n: list(d["summary"]["coverage"].values()) for n, d in results.items()},
-                         out / "coverage.png", "visible coverage % (validation buildings)",
-                         f"{args.views} views: the teacher's look-ahead on depth vs the tuned orbit")
-        write_json(out / "results.json", portable_record({
-            "commit": git_commit(), "scenes": args.scenes, "seeds": args.seeds, "views": args.views,
-            "results": results, "checks": checks, "command": sys.argv}))
+    results = looks_eval.evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work)
+    checks = looks_eval.policy_acceptance(results, args.scenes, names)
+    table = looks_eval.report(results, args.scenes, args.seeds, args.views, "orbit", checks)
+    with atomic_folder(args.out, overwrite=True, outputs=looks_eval.STUDY_OUTPUTS) as out:
+        looks_eval.write_study(out, args, results, checks, table,
+                               f"{args.views} views: the teacher's look-ahead on depth vs the tuned orbit")
     print(table)
 
 

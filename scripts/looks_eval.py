@@ -195,6 +195,23 @@ def passed(checks: list[dict]) -> str:
     return "{}/{}".format(*tally(checks))
 
 
+STUDY_OUTPUTS = ("results.json", "results.md", "coverage.png")
+"""The files `write_study` writes."""
+
+
+def write_study(out: Path, args: argparse.Namespace, results: dict, checks: dict[str, list[dict]], table: str,
+                title: str, **record) -> None:
+    """Into a study's open output folder `out`: its table (results.md), chart (coverage.png, titled `title`)
+    and record (results.json: the commit, the buildings, start views and views of `args`, `record`'s
+    entries, the results, the checks and the command line)."""
+    write_text(out / "results.md", table)
+    plot_seed_scores({n: list(d["summary"]["coverage"].values()) for n, d in results.items()},
+                     out / "coverage.png", "visible coverage % (validation buildings)", title)
+    write_json(out / "results.json", portable_record({
+        "commit": git_commit(), "scenes": args.scenes, "seeds": args.seeds, "views": args.views, **record,
+        "results": results, "checks": checks, "command": sys.argv}))
+
+
 def study_arguments(parser: argparse.ArgumentParser) -> None:
     """The options every validation study of this kind takes: buildings, start views, views, out, work."""
     parser.add_argument("--scenes", nargs="+", default=list(SCENES))
@@ -230,16 +247,9 @@ def main() -> None:
     checks = policy_acceptance(results, args.scenes, list(policies)) if "orbit" in args.baselines else {}
     table = report(results, args.scenes, args.seeds, args.views, args.baselines[0] if args.baselines else
                    next(iter(policies)), checks)
-    outputs = ("results.json", "results.md", "coverage.png")
-    with atomic_folder(args.out, overwrite=True, outputs=outputs) as out:
-        write_text(out / "results.md", table)
-        plot_seed_scores({n: list(d["summary"]["coverage"].values()) for n, d in results.items()},
-                         out / "coverage.png", "visible coverage % (validation buildings)",
-                         "13 views: policies vs the tuned orbit")
-        write_json(out / "results.json", portable_record({
-            "commit": git_commit(), "scenes": args.scenes, "seeds": args.seeds, "views": args.views,
-            "policies": dict(p.split("=", 1) for p in args.policy), "results": results, "checks": checks,
-            "command": sys.argv}))
+    with atomic_folder(args.out, overwrite=True, outputs=STUDY_OUTPUTS) as out:
+        write_study(out, args, results, checks, table, "13 views: policies vs the tuned orbit",
+                    policies=dict(p.split("=", 1) for p in args.policy))
     print(table)
 
 

@@ -38,7 +38,7 @@ from tensordict import TensorDict
 from torch import nn
 from tqdm import tqdm
 
-from common.io import atomic_folder, write_json, write_text
+from common.io import atomic_folder, write_json
 from common.provenance import git_commit, portable_record
 from common.threads import set_torch_threads
 from nbv.planning.base import Planner
@@ -50,11 +50,10 @@ from nbv.rl.config import EnvConfig, NetworkConfig
 from nbv.rl.env import NBVEnv
 from nbv.rl.expert import CANDIDATES
 from nbv.rl.presets import default_preset
-from nbv.viz.figures import plot_seed_scores
 from render.viewpoint import Viewpoint
 
 sys.path.insert(0, str(Path(__file__).parent))
-from looks_eval import evaluate, policy_acceptance, refuse_held_out, report, study_arguments  # noqa: E402
+import looks_eval  # noqa: E402
 
 OBSERVATION = ("pixels", "viewpoints", BOV_KEY)
 """The state keys the student reads."""
@@ -183,13 +182,13 @@ def arguments() -> argparse.Namespace:
     parser.add_argument("--privileged-unseen", action="store_true", help="the student reads the unseen map")
     parser.add_argument("--name", default="score-student", help="the student's name in the tables")
     parser.add_argument("--seed", type=int, default=0)
-    study_arguments(parser)
+    looks_eval.study_arguments(parser)
     return parser.parse_args()
 
 
 def main() -> None:
     args = arguments()
-    refuse_held_out(args.scenes)
+    looks_eval.refuse_held_out(args.scenes)
     config = default_preset()
     set_torch_threads(config.collector.threads)
     torch.manual_seed(args.seed)
@@ -216,21 +215,16 @@ def main() -> None:
     for stale in (args.work / args.name, args.work / f"{args.name}-blank"):  # a new student each run
         for saved in stale.glob("*.json"):
             saved.unlink()
-    results = evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work)
+    results = looks_eval.evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work)
     merge_blank(results, args.name)
-    checks = policy_acceptance(results, args.scenes, [args.name])
-    table = report(results, args.scenes, args.seeds, args.views, "orbit", checks)
-    outputs = ("results.json", "results.md", "coverage.png", "fit.json", "student.pt")
+    checks = looks_eval.policy_acceptance(results, args.scenes, [args.name])
+    table = looks_eval.report(results, args.scenes, args.seeds, args.views, "orbit", checks)
+    outputs = (*looks_eval.STUDY_OUTPUTS, "fit.json", "student.pt")
     with atomic_folder(args.out, overwrite=True, outputs=outputs) as out:
-        write_text(out / "results.md", table)
-        plot_seed_scores({n: list(d["summary"]["coverage"].values()) for n, d in results.items()},
-                         out / "coverage.png", "visible coverage % (validation buildings)",
-                         f"{args.views} views: a student ranking the teacher's steps")
-        record = {"commit": git_commit(), "command": sys.argv}
-        write_json(out / "fit.json", portable_record({**record, "rounds": log}))
-        write_json(out / "results.json", portable_record({
-            **record, "scenes": args.scenes, "seeds": args.seeds, "views": args.views, "results": results,
-            "checks": checks}))
+        looks_eval.write_study(out, args, results, checks, table,
+                               f"{args.views} views: a student ranking the teacher's steps")
+        write_json(out / "fit.json", portable_record({"commit": git_commit(), "command": sys.argv,
+                                                      "rounds": log}))
         torch.save(net.state_dict(), out / "student.pt")
     print(table)
 

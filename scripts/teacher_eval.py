@@ -20,8 +20,7 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from common.io import atomic_folder, write_json, write_text
-from common.provenance import git_commit, portable_record
+from common.io import atomic_folder
 from nbv.experiments.online_acceptance import building_mean
 from nbv.planning.base import Planner
 from nbv.planning.config import PlanSettings
@@ -30,16 +29,17 @@ from nbv.rl.config import EnvConfig, RewardConfig
 from nbv.rl.env import NBVEnv
 from nbv.rl.expert import EXPERT_KEY
 from nbv.rl.presets import looks_preset
-from nbv.viz.figures import plot_seed_scores
 from render.viewpoint import Viewpoint
 
 sys.path.insert(0, str(Path(__file__).parent))
 from looks_eval import (  # noqa: E402
+    STUDY_OUTPUTS,
     evaluate,
     policy_acceptance,
     refuse_held_out,
     report,
     study_arguments,
+    write_study,
 )
 
 
@@ -97,15 +97,8 @@ def main() -> None:
     results = evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work)
     checks = policy_acceptance(results, args.scenes, [name for name in planners if name.startswith(teacher)])
     table = report(results, args.scenes, args.seeds, args.views, "orbit", checks)
-    outputs = ("results.json", "results.md", "coverage.png")
-    with atomic_folder(args.out, overwrite=True, outputs=outputs) as out:
-        write_text(out / "results.md", table)
-        plot_seed_scores({n: list(d["summary"]["coverage"].values()) for n, d in results.items()},
-                         out / "coverage.png", "visible coverage % (validation buildings)",
-                         f"{args.views} views: the teacher vs the tuned orbit")
-        write_json(out / "results.json", portable_record({
-            "commit": git_commit(), "scenes": args.scenes, "seeds": args.seeds, "views": args.views,
-            "results": results, "checks": checks, "command": sys.argv}))
+    with atomic_folder(args.out, overwrite=True, outputs=STUDY_OUTPUTS) as out:
+        write_study(out, args, results, checks, table, f"{args.views} views: the teacher vs the tuned orbit")
     print(table)
     print("mean coverage:", {n: round(building_mean(d["summary"]["coverage"]), 1)
                              for n, d in results.items()})

@@ -16,7 +16,7 @@ from render.viewpoint import Viewpoint
 from scenes.spec import SceneSpec
 
 ROOT = Path(__file__).resolve().parents[3]
-SHIPPED = ("random", "circle", "orbit", "orbit2", "greedy", "hemisphere", "infogain", "policy",
+SHIPPED = ("random", "circle", "orbit", "orbit2", "greedy", "hemisphere", "infogain", "lookahead", "policy",
            "policy-sample", "policy-paper", "oracle")
 
 
@@ -46,7 +46,7 @@ def toy():
 
 def test_every_shipped_planner_has_one_entry_and_a_factory_that_makes_it():
     assert [e.name for e in entries()] == list(SHIPPED)
-    for name in ("random", "circle", "greedy", "hemisphere", "infogain", "oracle"):
+    for name in ("random", "circle", "greedy", "hemisphere", "infogain", "lookahead", "oracle"):
         assert isinstance(make_planner(name, PlanSettings()), Planner)
     assert [e.name for e in entries() if e.reads_truth] == ["oracle"]
     assert [e.name for e in entries() if e.checkpoint] == ["policy", "policy-sample"]

@@ -1,0 +1,98 @@
+"""The teacher's look-ahead on measured depth (`--planner lookahead`; issue 26's depth option, round 23).
+
+The privileged teacher of training (`nbv.rl.expert`) scores each of 125 orbit steps (an azimuth step of up
+to 60 degrees, an absolute radius and elevation: the default preset's action space) by the true surface
+samples that it and the next two steps the same way would be the first to see, discounted by 0.9 a step,
+less a flight cost a metre along the viewing shell. This planner runs the same scoring
+(`expert_scores`) at flight time on what a depth camera measures instead: an occupancy grid over the
+target's bounds (`nbv.recon.occupancy`, as the infogain planner's), fused from the depth image of every
+view flown. A voxel counts as seen once it is known (free or occupied); a view sees the unknown voxels its
+rays reach before an occupied one (`OccupancyGrid.reached`); a step scores 100 x the share of the grid's
+voxels its views are the first to reach. It reads depth and the poses flown, never the mesh (but the
+target's bounding box, as infogain does), so issue 26 reports it apart from the policies that read images
+alone.
+
+The grid, the rays and the flight weight were chosen on the validation buildings
+(paper_results/selection/round23, section 4): 48 voxels along the longest side, `LOOKAHEAD_RAYS` rays
+across the image (every 4th pixel at 160 x 120), 0.05 a metre: 4.6 points more coverage than the tuned
+ring there, at least 1.0 more on every building, in 1.41x its metres. `lookahead:W` flies another flight
+weight W (coverage points a metre).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from nbv.flight.path import shell_path
+from nbv.planning.base import Planner
+from nbv.planning.infogain import target_grid
+from nbv.recon.config import OccupancyConfig
+from nbv.recon.occupancy import UNKNOWN
+from nbv.rl.env import action_to_viewpoint
+from nbv.rl.expert import best_action, expert_scores
+from nbv.rl.presets import ORBIT_STEP
+from render.viewpoint import Viewpoint, viewpoint_to_c2w
+
+if TYPE_CHECKING:
+    from nbv.planning.config import PlanSettings
+    from nbv.planning.world import PlanningWorld
+
+LOOKAHEAD_GRID = 48
+"""Voxels along the longest side of the target's padded bounds (round 23: 32 blurred a courtyard)."""
+LOOKAHEAD_RAYS = 40
+"""Rays across the image's width that a look-ahead view casts (and its height in proportion)."""
+LOOKAHEAD_FLIGHT = 0.05
+"""The flight cost, coverage points (of the grid's voxels) a metre along the viewing shell."""
+HORIZON, DISCOUNT = 3, 0.9
+"""Views scored ahead per candidate step, and the weight a step further (the teacher's defaults)."""
+
+
+class LookaheadPlanner(Planner):
+    """The teacher's look-ahead on an occupancy grid fused from the depth flown (module docstring)."""
+
+    name = "lookahead"
+
+    def __init__(self, flight: float = LOOKAHEAD_FLIGHT, grid: int = LOOKAHEAD_GRID,
+                 rays: int = LOOKAHEAD_RAYS, default_views: int = 13) -> None:
+        if not 0 <= flight < float("inf") or grid < 1 or rays < 1:
+            raise ValueError(f"lookahead needs a finite flight weight >= 0, grid >= 1 and rays >= 1, got "
+                             f"{flight}, {grid}, {rays}")
+        self.flight, self.grid, self.rays, self.default_views = flight, grid, rays, default_views
+
+    def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
+        """The start view, then each next one the orbit step whose look-ahead on the grid scores best."""
+        camera, center = world.camera, world.target.center()
+        stride = max(1, round(camera.width / self.rays))
+        grid = target_grid(world.target, OccupancyConfig(grid_resolution=self.grid, gain_ray_stride=stride))
+        steps = replace(world.env, action_mode="orbit", relative_step=ORBIT_STEP)
+
+        def sees(view: Viewpoint) -> np.ndarray:
+            return grid.reached(camera.K, viewpoint_to_c2w(view, center), camera.width, camera.height, stride)
+
+        def step(action: np.ndarray, view: Viewpoint) -> Viewpoint:
+            return action_to_viewpoint(action, view, steps)
+
+        view, chosen = world.start, [world.start]
+        for left in range((self.default_views if views is None else views) - 1, 0, -1):
+            grid.integrate(world.source.render_depth(view), camera.K, viewpoint_to_c2w(view, center),
+                           OccupancyConfig().integrate_ray_stride)
+            known = grid.state.reshape(-1) != UNKNOWN
+            scores = expert_scores(view, known, sees, step, self.flight, left, HORIZON, DISCOUNT,
+                                   flown_m=shell_path(chosen[0], chosen[1:]).total_m)
+            view = step(best_action(scores), view)
+            chosen.append(view)
+        return chosen
+
+
+def lookahead_planner(settings: PlanSettings, seed: int, argument: str | None) -> LookaheadPlanner:
+    """The registry's `lookahead`: the validated setting, or `lookahead:W` with flight weight W a metre."""
+    if argument is None:
+        return LookaheadPlanner()
+    try:
+        flight = float(argument)
+    except ValueError:
+        raise ValueError(f"lookahead:W takes a flight weight a metre, got {argument!r}") from None
+    return LookaheadPlanner(flight=flight)

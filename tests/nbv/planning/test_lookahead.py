@@ -1,0 +1,53 @@
+"""The `lookahead` planner on the test building: it flies the teacher's orbit steps from the start view, each
+chosen by the look-ahead on the grid fused from its depth; a dear enough flight makes it take the shortest
+leg; `lookahead:W` sets the weight, bad ones refused by their messages."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from nbv.flight.path import shell_path
+from nbv.planning.config import PlanSettings
+from nbv.planning.lookahead import LOOKAHEAD_FLIGHT, LookaheadPlanner, lookahead_planner
+from nbv.planning.registry import make_planner
+from nbv.planning.world import PlanningWorld
+from nbv.rl.env import action_to_viewpoint
+from nbv.rl.expert import CANDIDATES
+from nbv.rl.presets import ORBIT_STEP
+from tests.nbv.rl.test_bov_observation import config
+
+
+def steps_from(view, env) -> list:
+    orbit = replace(env, action_mode="orbit", relative_step=ORBIT_STEP)
+    return [action_to_viewpoint(a, view, orbit) for a in CANDIDATES]
+
+
+def test_each_view_is_an_orbit_step_and_an_unseen_side_draws_it_round():
+    env = config()
+    world = PlanningWorld(env, seed=3)
+    views = LookaheadPlanner(flight=0.0, grid=16, rays=8).plan(world, 4)
+    assert len(views) == 4 and views[0] == world.start
+    for before, after in zip(views, views[1:]):
+        assert any(np.allclose(after.as_array(), s.as_array()) for s in steps_from(before, env))
+    turned = [abs(np.angle(np.exp(1j * (b.azimuth - a.azimuth)))) for a, b in zip(views, views[1:])]
+    assert max(turned) > 0.5  # free flight: it turns to the sides its depth has not seen
+
+
+def test_a_dear_flight_takes_the_shortest_leg():
+    env = config()
+    world = PlanningWorld(env, seed=3)
+    views = LookaheadPlanner(flight=1e5, grid=16, rays=8).plan(world, 2)
+    legs = [shell_path(world.start, [s]).total_m for s in steps_from(world.start, env)]
+    assert shell_path(world.start, views[1:]).total_m == min(legs)
+
+
+def test_the_spec_sets_the_flight_weight_and_refuses_bad_ones():
+    assert make_planner("lookahead", PlanSettings()).flight == LOOKAHEAD_FLIGHT
+    assert make_planner("lookahead:0.2", PlanSettings()).flight == 0.2
+    with pytest.raises(ValueError, match="takes a flight weight a metre, got 'fast'"):
+        lookahead_planner(PlanSettings(), 0, "fast")
+    with pytest.raises(ValueError, match="finite flight weight >= 0"):
+        lookahead_planner(PlanSettings(), 0, "-1")

@@ -98,7 +98,7 @@ PLANNERS: tuple[PlannerEntry, ...] = (
                  "nbv.planning.infogain:infogain_planner", settings=("candidates", "occupancy", "links")),
     PlannerEntry("lookahead", "the training teacher's look-ahead on measured depth (issue 26's depth "
                  "option): the orbit step whose next three views would first reach the most unknown voxels "
-                 "of an occupancy grid fused from the depth flown, less 0.05 a metre flown (lookahead:W "
+                 "of an occupancy grid fused from the depth flown, less 0.07 a metre flown (lookahead:W "
                  "another weight)", "nbv.planning.lookahead:lookahead_planner", argument="W", budget=False),
     PlannerEntry("policy", "a trained actor (a `nbv train` checkpoint.pt or policy.pt; none: the shipped "
                  "policy) from the start view, acting on its distribution's mode",

@@ -7,10 +7,11 @@ set against the full scan (Sec. VI-B), then a table and pictures: contact
 sheet, trajectories, distance heat maps. The online half (paper Sec. IV-VI-A)
 follows: the shipped policy plans one pass around a held-out building
 (`online_scene`), its views are captured, fused and scored against the ground
-truth beside random views and the tuned orbits (the registry's `tuned`
-entries) at the same count (`nbv plan` runs, `online_*/`; one-run planner
-studies, `online_study`, under the demo's camera, rendering, fusion and
-metric settings).
+truth beside random views, the tuned orbits (the registry's `tuned`
+entries) and the depth option (`lookahead`, the registry's `depth_option`)
+at the same count (`nbv plan` runs, `online_*/`; one-run planner studies,
+`online_study`, under the demo's camera, rendering, fusion and metric
+settings).
 
 Everything but the full scan (`OUTPUTS`) is written into one temporary folder and
 swapped onto `--out` at the end (`common.io.atomic_folder`), so an interrupted demo
@@ -40,7 +41,7 @@ from nbv.experiments.planner_study import PlannerStudy, run_study
 from nbv.experiments.sfm_columns import SFM_HEADER, sfm_cells, sfm_entry
 from nbv.experiments.study import FullScanStudy
 from nbv.planning.config import PlanSettings
-from nbv.planning.registry import tuned_planners
+from nbv.planning.registry import depth_planners, tuned_planners
 from nbv.recon.heatmap import write_heatmap
 from nbv.recon.metrics import SurfaceMetrics, evaluate_surfaces
 from nbv.recon.tsdf import Reconstruction, reconstruct_dataset, save_reconstruction
@@ -53,8 +54,8 @@ from scenes.model import Scene
 OUTPUTS = ("refined", "recon_full", "recon_refined", "contact_sheet.png", "trajectory_full.png",
            "trajectory_refined.png", "heatmap_refined_vs_full.png", "heatmap_refined_vs_full.ply",
            "heatmap_full_vs_gt.png", "heatmap_full_vs_gt.ply", "results.json", "results.md", "online_policy",
-           "online_random", *(f"online_{name}" for name in tuned_planners()), "sfm_full", "sfm_refined",
-           "refined_linked", "sfm_refined_linked")
+           "online_random", *(f"online_{name}" for name in (*tuned_planners(), *depth_planners())),
+           "sfm_full", "sfm_refined", "refined_linked", "sfm_refined_linked")
 """What one demo run writes into `--out`, all together (the cached `full_scan/` beside them is kept)."""
 
 
@@ -195,12 +196,12 @@ def online_study(config: DemoConfig, folder: Path, name: str, planner: str,
 
 
 def online_half(config: DemoConfig, folder: Path) -> dict[str, dict[str, Any]]:
-    """The policy's one pass around `online_scene`, then random views and the registry's tuned orbits
-    (`tuned_planners`) at its count: `nbv plan` runs."""
+    """The policy's one pass around `online_scene`, then random views, the registry's tuned orbits
+    (`tuned_planners`) and depth options (`depth_planners`) at its count: `nbv plan` runs."""
     policy = run_study(online_study(config, folder, "policy", config.policy, None))[0].plan()
     keep = ("views", "planning_s", "gt", "flight_m", "azimuth_reversals", *(("sfm",) if config.sfm else ()))
     runs = {"policy": policy}
-    for name in ("random", *tuned_planners()):
+    for name in ("random", *tuned_planners(), *depth_planners()):
         runs[name] = run_study(online_study(config, folder, name, name, policy["views"]))[0].plan()
     return {name: {k: plan[k] for k in keep} for name, plan in runs.items()}
 
@@ -258,8 +259,8 @@ def results_table(results: dict[str, Any], metrics: dict[str, dict[str, SurfaceM
                  run["azimuth_reversals"]] for name, run in results["online"].items()]
         header = ["planner", "views", "planning (s)", "Chamfer vs gt (cm)", "Hausdorff vs gt (cm)",
                   "coverage vs gt", "flight (m)", "azimuth reversals"]
-        lines += [f"## Online half: {scene} (held out): the policy's one pass, random views and the tuned "
-                  "orbits at its count", "",
+        lines += [f"## Online half: {scene} (held out): the policy's one pass, random views, the tuned "
+                  "orbits and the depth option (it reads the depth it measures) at its count", "",
                   markdown_table(header, rows),
                   "Trajectory: online_policy/trajectory.png. Paper Fig. 7 (vs its full scan): "
                   + ", ".join(f"{k} Hausdorff {v['hausdorff_cm']} cm, Chamfer {v['chamfer_cm']} cm"

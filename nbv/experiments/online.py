@@ -47,7 +47,7 @@ from nbv.experiments.planner_study import run_studies, scene_folder
 from nbv.experiments.sfm_columns import sfm_table
 from nbv.fanout.config import ExecutorConfig
 from nbv.planning.config import PlanSettings
-from nbv.planning.registry import SHIPPED_POLICIES, compared_planners, entry, planner_label
+from nbv.planning.registry import SHIPPED_POLICIES, compared_planners, depth_planners, entry, planner_label
 from nbv.recon.config import MetricsConfig
 from nbv.sfm.config import SfmOption
 from nbv.viz.figures import plot_seed_scores
@@ -74,6 +74,10 @@ class OnlineConfig(SfmOption):
     """Policies to evaluate on their mode (policy: the shipped default; policy-paper: the paper preset's, so
     the paper's method stands beside ours; policy:CHECKPOINT for others); the first is the one the margins
     describe. Each flies the one-pass protocol too."""
+    depth_options: tuple[str, ...] = field(default_factory=depth_planners)
+    """Issue 26's named depth options (the registry's: `lookahead`), flown at the fixed budget and held to the
+    policies' checks in columns of their own, reported apart from the policies (which read only images and
+    poses); none with `--depth-options` alone."""
     baselines: tuple[str, ...] = field(default_factory=compared_planners)
     """Baseline planners at the same view count (the registry's compared ones: random, circle, the tuned
     orbits, greedy)."""
@@ -107,7 +111,7 @@ def comparisons(config: OnlineConfig) -> list[CompareConfig]:
                   "executor": config.executor, "sfm": config.sfm, "sfm_settings": config.sfm_settings}
         folder = Path(config.out) / scene_folder(scene)
         found.append(CompareConfig(**common, views=config.views, out=folder / f"views{config.views}",
-                                   planners=(*config.policies, *config.baselines)))
+                                   planners=(*config.policies, *config.depth_options, *config.baselines)))
         if config.one_pass:
             found.append(CompareConfig(**common, planners=config.policies, out=folder / "onepass"))
         seeing = tuple(p for p in config.policies if "blank_images" in entry(p).settings)
@@ -130,7 +134,8 @@ def run_online(config: OnlineConfig) -> str:
                  else one_pass)
         found[comparison.scene.scene] = _runs(comparison.out)
     policy = planner_label(config.policies[0])
-    checks = acceptance_checks(budget, blank or None, [planner_label(spec) for spec in config.policies])
+    checks = acceptance_checks(budget, blank or None, [planner_label(spec) for spec in config.policies],
+                               [planner_label(spec) for spec in config.depth_options])
     coverage = {label: mean_coverage(budget, label) for label in next(iter(budget.values()))}
     text = online_report(budget, coverage, one_pass, policy, config, checks)
     record = portable_record(config_record(config, omit=("executor",)))
@@ -149,6 +154,7 @@ def rerun_command(config: OnlineConfig) -> str:
     portable: `portable_text`)."""
     return portable_text(
         f"nbv online --scenes {' '.join(config.scenes)} --policies {' '.join(config.policies)} "
+        f"--depth-options{''.join(' ' + spec for spec in config.depth_options)} "
         f"--baselines {' '.join(config.baselines)} --seeds {' '.join(map(str, config.seeds))} "
         f"--views {config.views}{'' if config.blank else ' --no-blank'} --out DIR")
 
@@ -171,6 +177,7 @@ def online_report(budget: dict[str, dict[str, list[dict]]], coverage: dict[str, 
     """The Markdown report: 13-view coverage per building (`coverage`, by planner label, `mean_coverage`)
     with the policy's margins, then one pass, then the acceptance checks (`checks`, by policy)."""
     labels = list(coverage)
+    depth = [planner_label(spec) for spec in config.depth_options]
     rows = [[scene, *(f"{coverage[label][scene]:.1f}" for label in labels)] for scene in budget]
     overall = {label: building_mean(by) for label, by in coverage.items()}
     rows.append(["**mean**", *(f"**{overall[label]:.1f}**" for label in labels)])
@@ -181,7 +188,9 @@ def online_report(budget: dict[str, dict[str, list[dict]]], coverage: dict[str, 
     lines = [f"# Online NBV on held-out buildings (commit {git_commit()})", "",
              f"Coverage (%) of the true surface within {config.settings.metrics.threshold_cm:g} cm, "
              f"{config.views} views, mean over seeds {', '.join(map(str, config.seeds))}; "
-             "policies act on their mode.", "",
+             "policies act on their mode" + ("" if not config.depth_options else
+                                             f" and read only images and poses; {', '.join(depth)} "
+                                             "(the depth option) reads the depth it measures") + ".", "",
              f"Re-run: `{rerun_command(config)}`", "",
              markdown_table(["building", *labels], rows), "",
              "Flight per scan (m along the viewing shell from the start view through the views in order "
@@ -190,7 +199,7 @@ def online_report(budget: dict[str, dict[str, list[dict]]], coverage: dict[str, 
              "Planning time per scan, s (all / without the simulated camera, i.e. loading the scene into "
              "the renderer and rendering the views flown to; `plan.json`'s `planning_s` / `deciding_s`): "
              + ", ".join(f"{label} {planning[label]:.2f} / {deciding[label]:.2f}" for label in labels), ""]
-    for other in compared_planners():
+    for other in (*compared_planners(), *depth):
         if other in overall and policy in overall:
             lines.append(f"- {policy} minus {other}: {overall[policy] - overall[other]:+.1f} points")
     if "greedy" in deciding and policy in deciding:
@@ -205,7 +214,7 @@ def online_report(budget: dict[str, dict[str, list[dict]]], coverage: dict[str, 
     if one_pass:
         lines += ["", "## One pass around the target (the paper's protocol), against the full 288-view scan",
                   "", _one_pass_table(one_pass, policies)]
-    lines += acceptance_section(checks, len(budget))
+    lines += acceptance_section(checks, len(budget), [planner_label(spec) for spec in config.depth_options])
     if config.sfm:
         lines += _sfm_section(budget, one_pass, config.views)
     return "\n".join(lines) + "\n"

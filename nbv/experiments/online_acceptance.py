@@ -11,7 +11,9 @@ For each policy, against the tuned single ring (`orbit`, chosen on training buil
   on average (`nbv.flight.spread`), and with every captured image blank its mean coverage at least
   `BLANK_DROP` points lower.
 The two tuned rings (`orbit2`), the strongest fixed pattern, are reported beside them without a bar. A
-check whose planners were not run reads "n/a" and fails the whole.
+check whose planners were not run reads "n/a" and fails the whole. A named depth option (`lookahead`) is held
+to the same checks in a column of its own, but for the blank images: it reads no image, so that check does
+not apply to it (its looking shows in the path spread).
 """
 
 from __future__ import annotations
@@ -60,8 +62,9 @@ def mean_flight(runs: Runs, label: str) -> float:
     return float(np.mean([r["flight_m"] for by in runs.values() for r in by[label]]))
 
 
-def policy_checks(runs: Runs, blank: Runs | None, policy: str) -> list[dict]:
-    """The acceptance checks of one policy: each {check, bar, value, passed} (value None: not measurable)."""
+def policy_checks(runs: Runs, blank: Runs | None, policy: str, reads_images: bool = True) -> list[dict]:
+    """The acceptance checks of one policy: each {check, bar, value, passed} (value None: not measurable;
+    passed None: no bar, as for the blank images of a planner that reads none, `reads_images` False)."""
     have = set.intersection(*(set(by) for by in runs.values()))
     mine = mean_coverage(runs, policy)
     overall = building_mean(mine)
@@ -86,9 +89,13 @@ def policy_checks(runs: Runs, blank: Runs | None, policy: str) -> list[dict]:
     add("path spread, closest pair of buildings, m", f">= {SPREAD_M:.2f}",
         min(spreads.values()) if spreads else None, lambda v: v >= SPREAD_M, "{:.2f}")
     flown_blind = blank and all(policy in by for by in blank.values())
-    add("coverage lost with blank images, points", f">= {BLANK_DROP:.1f}",
-        overall - building_mean(mean_coverage(blank, policy)) if flown_blind else None,
-        lambda v: v >= BLANK_DROP)
+    blind = ("coverage lost with blank images, points", f">= {BLANK_DROP:.1f}")
+    if reads_images:
+        add(*blind, overall - building_mean(mean_coverage(blank, policy)) if flown_blind else None,
+            lambda v: v >= BLANK_DROP)
+    else:
+        checks.append({"check": blind[0], "bar": blind[1], "value": None, "passed": None,
+                       "shown": "does not apply (reads no image)"})
     if "orbit2" in have:
         checks.append({"check": "mean coverage minus the two tuned rings' (orbit2), points",
                        "bar": "reported", "value": overall - building_mean(mean_coverage(runs, "orbit2")),
@@ -116,13 +123,17 @@ def _random_check(runs: Runs, mine: dict[str, float], have: set[str]) -> tuple:
     return check, bar, min(mine[s] - rand[s] for s in mine), lambda _: passed
 
 
-def acceptance_checks(runs: Runs, blank: Runs | None, policies: Sequence[str]) -> dict[str, list[dict]]:
-    """Every policy's checks (`policy_checks`), by policy label."""
-    return {policy: policy_checks(runs, blank, policy) for policy in policies}
+def acceptance_checks(runs: Runs, blank: Runs | None, policies: Sequence[str],
+                      depth: Sequence[str] = ()) -> dict[str, list[dict]]:
+    """Every policy's checks (`policy_checks`), then every depth option's (reading no image), by label."""
+    return ({policy: policy_checks(runs, blank, policy) for policy in policies}
+            | {option: policy_checks(runs, blank, option, reads_images=False) for option in depth})
 
 
-def acceptance_section(checks: Mapping[str, list[dict]], buildings: int) -> list[str]:
-    """The Markdown lines of the acceptance table: a row per check, a column per policy."""
+def acceptance_section(checks: Mapping[str, list[dict]], buildings: int,
+                       depth: Sequence[str] = ()) -> list[str]:
+    """The Markdown lines of the acceptance table: a row per check, a column per policy (the depth options'
+    headed "(depth)")."""
     policies = list(checks)
     rows = [[c["check"], c["bar"], *(_cell(checks[p][i]) for p in policies)]
             for i, c in enumerate(checks[policies[0]])]
@@ -132,7 +143,8 @@ def acceptance_section(checks: Mapping[str, list[dict]], buildings: int) -> list
             "Coverage of the true surface at the fixed budget, mean over seeds per building; metres along "
             "the viewing shell; path spread: mean distance between camera positions on two buildings from "
             "the same start view; blank images: the same runs with every captured image replaced by a blank "
-            "one (`--blank`).", "", markdown_table(["check", "bar", *policies], rows)]
+            "one (`--blank`).", "", markdown_table(["check", "bar", *(f"{p} (depth)" if p in depth else p
+                                                                 for p in policies)], rows)]
 
 
 def tally(checks: Sequence[dict]) -> tuple[int, int]:
@@ -144,6 +156,6 @@ def tally(checks: Sequence[dict]) -> tuple[int, int]:
 
 def _cell(check: dict) -> str:
     if check["value"] is None:
-        return "n/a (no)"
+        return "n/a (no)" if check["passed"] is not None else check["shown"]
     shown = check["shown"] or f"{check['value']:+.1f}"
     return shown if check["passed"] is None else f"{shown} ({'yes' if check['passed'] else 'no'})"

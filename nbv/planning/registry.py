@@ -63,6 +63,10 @@ class PlannerEntry:
     tuned: bool = False
     """A fixed pattern chosen on the training buildings (the tuned orbits): the demo's online half flies it
     beside the policy and random views."""
+    depth_option: bool = False
+    """Issue 26's named depth option: a planner that looks at the depth it measures (the policies read only
+    images and poses). `nbv online` holds it to the policies' checks in a column of its own, and the demo
+    flies it beside them."""
 
     @property
     def spec(self) -> str:
@@ -99,7 +103,8 @@ PLANNERS: tuple[PlannerEntry, ...] = (
     PlannerEntry("lookahead", "the training teacher's look-ahead on measured depth (issue 26's depth "
                  "option): the orbit step whose next three views would first reach the most unknown voxels "
                  "of an occupancy grid fused from the depth flown, less 0.07 a metre flown (lookahead:W "
-                 "another weight)", "nbv.planning.lookahead:lookahead_planner", argument="W", budget=False),
+                 "another weight)", "nbv.planning.lookahead:lookahead_planner", argument="W", budget=False,
+                 depth_option=True),
     PlannerEntry("policy", "a trained actor (a `nbv train` checkpoint.pt or policy.pt; none: the shipped "
                  "policy) from the start view, acting on its distribution's mode",
                  "nbv.planning.policy:policy_planner", settings=("blank_images",), checkpoint=True),
@@ -217,6 +222,12 @@ def compared_planners() -> tuple[str, ...]:
 def tuned_planners() -> tuple[str, ...]:
     """The fixed patterns chosen on the training buildings: every entry with `tuned` set."""
     return tuple(e.name for e in entries() if e.tuned)
+
+
+def depth_planners() -> tuple[str, ...]:
+    """The named depth options (`nbv online --depth-options`, the demo's online half): every entry with
+    `depth_option` set."""
+    return tuple(e.name for e in entries() if e.depth_option)
 
 
 def replanned() -> tuple[str, ...]:

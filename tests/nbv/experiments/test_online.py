@@ -27,11 +27,12 @@ def save_run(folder, views: int, coverage: float, planning_s: float, legs: tuple
 
 
 def test_online_report_from_saved_runs(tmp_path):
-    # Two buildings, two seeds: the policy covers 80/90 %, another seed's 70/80, random 70, circle 60,
-    # greedy 85 (gt).
-    coverage = {"policy-shipped": (0.8, 0.9), "policy-seed1": (0.7, 0.8), "random": (0.7, 0.7),
-                "circle": (0.6, 0.6), "greedy": (0.85, 0.85)}
-    planning = {"policy-shipped": 0.5, "policy-seed1": 0.5, "random": 0.0, "circle": 0.0, "greedy": 50.0}
+    # Two buildings, two seeds: the policy covers 80/90 %, another seed's 70/80, the depth option 90, random
+    # 70, circle 60, greedy 85 (gt).
+    coverage = {"policy-shipped": (0.8, 0.9), "policy-seed1": (0.7, 0.8), "lookahead": (0.9, 0.9),
+                "random": (0.7, 0.7), "circle": (0.6, 0.6), "greedy": (0.85, 0.85)}
+    planning = {"policy-shipped": 0.5, "policy-seed1": 0.5, "lookahead": 2.0, "random": 0.0, "circle": 0.0,
+                "greedy": 50.0}
     for scene in ("alpine_chalet", "random:5"):
         root = tmp_path / scene_folder(scene)
         for label, values in coverage.items():
@@ -48,12 +49,14 @@ def test_online_report_from_saved_runs(tmp_path):
                           policies=("policy", f"policy:{tmp_path / 'seed1' / 'policy.pt'}"),
                           baselines=("random", "circle", "greedy"))
     text = run_online(config)
-    assert "| **mean** | **85.0** | **75.0** | **70.0** | **60.0** | **85.0** |" in text
+    assert "| **mean** | **85.0** | **75.0** | **90.0** | **70.0** | **60.0** | **85.0** |" in text
     assert "- policy-shipped minus random: +15.0 points" in text
+    assert "- policy-shipped minus lookahead: -5.0 points" in text
+    assert "lookahead (the depth option) reads the depth it measures" in text
     assert "- policy-shipped minus greedy: +0.0 points" in text
     assert ("Re-run: `nbv online --scenes alpine_chalet random:5 --policies policy "
-            "policy:ELSEWHERE/seed1/policy.pt --baselines random circle greedy --seeds 0 1 --views 13 "
-            "--out DIR`") in text  # no machine's folders in a committed report
+            "policy:ELSEWHERE/seed1/policy.pt --depth-options lookahead --baselines random circle greedy "
+            "--seeds 0 1 --views 13 --out DIR`") in text  # no machine's folders in a committed report
     assert "- planning speed-up over greedy (without the simulated camera): 100x" in text
     spread = ("- spread over the 2 policies: 10.0 points "
               "(policy-shipped 85.0, policy-seed1 75.0)")
@@ -63,21 +66,25 @@ def test_online_report_from_saved_runs(tmp_path):
     assert row == "| random:5 (policy-shipped) | 10.5 | 80.0 | 3.00 | 0.80 | 75.0 | 4.0 |"
     row = next(line for line in text.splitlines() if line.startswith("| random:5 (policy-seed1)"))
     assert row == "| random:5 (policy-seed1) | 12.5 | 70.0 | 3.00 | 0.80 | 65.0 | 4.0 |"
-    assert "| random:5 | 5.5 / 0.0 | 5.5 / 0.0 | 5.5 / 0.5 | 5.5 / 0.0 | 5.5 / 0.0 |" in text  # m / reversals
-    assert "| **mean** | **5.0 / 0.0** | **5.0 / 0.0** | **5.0 / 0.5** | **5.0 / 0.0** |" in text
+    assert "| random:5 | 5.5 / 0.0 | 5.5 / 0.0 | 5.5 / 0.0 | 5.5 / 0.5 | 5.5 / 0.0 | 5.5 / 0.0 |" in text
+    assert "| **mean** | **5.0 / 0.0** | **5.0 / 0.0** | **5.0 / 0.0** | **5.0 / 0.5** | **5.0 / 0.0** |" in (
+        text)
     assert "| paper Fig. 7 (alpine_chalet) | - | - | 9.47 | 1.01 | - |" in text
     assert "## Acceptance (issue 26): each policy against the tuned orbit on 2 buildings" in text
-    assert "| coverage lost with blank images, points | >= 3.0 | +15.0 (yes) | +5.0 (yes) |" in text
-    no_orbit = "| mean coverage minus the tuned orbit's, points | >= +3.0 | n/a (no) | n/a (no) |"
+    assert "| check | bar | policy-shipped | policy-seed1 | lookahead (depth) |" in text
+    assert ("| coverage lost with blank images, points | >= 3.0 | +15.0 (yes) | +5.0 (yes) | does not apply "
+            "(reads no image) |") in text
+    no_orbit = "| mean coverage minus the tuned orbit's, points | >= +3.0 | n/a (no) | n/a (no) | n/a (no) |"
     assert no_orbit in text
-    assert "| path spread, closest pair of buildings, m | >= 0.20 | 0.00 (no) | 0.00 (no) |" in text
+    spread = "| path spread, closest pair of buildings, m | >= 0.20 | 0.00 (no) | 0.00 (no) | 0.00 (no) |"
+    assert spread in text
     assert (tmp_path / "online.md").read_text() == text
     saved = json.loads((tmp_path / "online.json").read_text())
     assert saved["config"]["seeds"] == [0, 1] and len(saved["budget"]["random:5"]["greedy"]) == 2
     assert str(tmp_path) not in json.dumps(saved)
     assert saved["config"]["out"] == f"ELSEWHERE/{tmp_path.parent.name}/{tmp_path.name}"
     assert len(saved["blank"]["random:5"]["policy-seed1"]) == 2 and set(saved["acceptance"]) == {
-        "policy-shipped", "policy-seed1"}
+        "policy-shipped", "policy-seed1", "lookahead"}
     assert Image.open(tmp_path / "online.png").size[0] > 300
     assert scene_folder("random:5") == "random_5"
 
@@ -99,13 +106,14 @@ def test_online_hands_every_run_of_every_building_to_the_executor_at_once(tmp_pa
     references = unique_tasks([task for refs, _ in stages for task in refs])
     runs = unique_tasks([task for _, plans in stages for task in plans])
     # one reference per building (both protocols share it); the two policies (the default's, the paper's)
-    # and the registry's 5 compared baselines (random, circle, orbit, orbit2, greedy) x 2 seeds at 13 views,
-    # + each policy's one pass + each policy's 13 views with blank images
+    # the depth option (lookahead) and the registry's 5 compared baselines (random, circle, orbit, orbit2,
+    # greedy) x 2 seeds at 13 views, + each policy's one pass + each policy's 13 views with blank images
     assert config.baselines == ("random", "circle", "orbit", "orbit2", "greedy")
+    assert config.depth_options == ("lookahead",)
     assert [task.name for task in references] == ["full-scan reference of alpine_chalet",
                                                   "full-scan reference of random:5"]
     assert config.policies == ("policy", "policy-paper")
-    assert len(runs) == 2 * (7 * 2 + 2 * 2 + 2 * 2)
+    assert len(runs) == 2 * (8 * 2 + 2 * 2 + 2 * 2)
     assert runs[-1].name == f"policy-paper-seed1 in {tmp_path}/random_5/views13-blank"
     assert runs[-1].result == tmp_path / "random_5" / "views13-blank" / "policy-paper-seed1" / "plan.json"
     blank = [c for c in comparisons(config) if c.settings.blank_images]

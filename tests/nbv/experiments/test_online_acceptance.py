@@ -87,3 +87,20 @@ def test_pair_spreads_average_over_shared_start_views_only():
     assert spreads == {("A", "B"): pytest.approx(0.25), ("A", "C"): 0.0, ("B", "C"): 0.0}
     with pytest.raises(ValueError, match="share no start view"):
         pair_spreads_m({"A": {0: ring}, "B": {1: ring}})
+
+
+def test_a_depth_option_is_held_to_every_check_but_the_blank_images_it_never_reads():
+    runs = study({"policy-shipped": POLICY, "lookahead": POLICY, **BASELINES,
+                  "oracle": planner((0.95, 0.95), (0.905, 0.905))})
+    checks = acceptance_checks(runs, BLANK, ["policy-shipped"], ["lookahead"])
+    assert list(checks) == ["policy-shipped", "lookahead"]
+    blind = by_check(checks["lookahead"])["coverage lost with blank images"]
+    assert blind["value"] is None and blind["passed"] is None  # no bar: it reads no image
+    assert [c["value"] for c in checks["lookahead"] if c is not blind] == [
+        c["value"] for c in checks["policy-shipped"] if "blank" not in c["check"]]  # the same flights
+    text = "\n".join(acceptance_section(checks, 2, ["lookahead"]))
+    assert "| check | bar | policy-shipped | lookahead (depth) |" in text
+    row = ("| coverage lost with blank images, points | >= 3.0 | +5.5 (yes) "
+           "| does not apply (reads no image) |")
+    assert row in text
+    assert "| **every check** |  | **yes** | **yes** |" in text  # 5 of 5 barred checks for the depth option

@@ -227,7 +227,8 @@ def test_a_registered_toy_planner_runs_through_compare_online_and_the_budget_cur
     viewpoints = json.loads((tmp_path / "cmp" / "toy-seed0" / "plan.json").read_text())["viewpoints"]
     assert viewpoints == [[2.0, 0.7 * k, 0.5] for k in range(3)]
     text = run_online(OnlineConfig(out=tmp_path / "online", scenes=("test_building",), policies=("toy",),
-                                   baselines=("random",), seeds=(0,), views=3, settings=scored))
+                                   depth_options=(), baselines=("random",), seeds=(0,), views=3,
+                                   settings=scored))
     assert "| test_building | " in text and "| test_building (toy) | 3.0 |" in text
     assert "toy" in BudgetConfig().planners  # a registered planner joins the budget study's defaults
     rows = run_budget(BudgetConfig(out=tmp_path / "budget", scenes=("test_building",), planners=("toy",),

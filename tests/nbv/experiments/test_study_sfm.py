@@ -90,7 +90,8 @@ def test_online_and_budget_reports_give_one_sfm_row_per_building_planner_and_pla
         folder = tmp_path / "test_building" / "views13" / f"{planner}-seed0"
         save_run(folder, sfm_headline(registered, 1, 1.5))
     text = run_online(OnlineConfig(out=tmp_path, scenes=("test_building",), policies=("random",),
-                                   baselines=("circle",), seeds=(0,), one_pass=False, sfm=True))
+                                   depth_options=(), baselines=("circle",), seeds=(0,), one_pass=False,
+                                   sfm=True))
     assert "| test_building | random | 13/13 | 1.0 | 1.5 |" in text
     assert "| test_building | circle | 4/13 | 1.0 | 1.5 |" in text
     plan = tmp_path / "plan"

@@ -35,6 +35,7 @@ import argparse
 import json
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
@@ -111,23 +112,34 @@ def strip_unseen(states: TensorDict) -> TensorDict:
     return states.set(BOV_KEY, states[BOV_KEY][..., :-UNSEEN_MAP_SIZE])
 
 
-def fit(actor, optimiser, data: TensorDict, held: TensorDict | None, epochs: int, batch: int,
-        generator: torch.Generator) -> list[dict]:
-    """`epochs` passes of minibatch Adam on `mode_distance` over `data`; per pass, the mean training loss and
-    the loss on the `held` states (never fitted), if any."""
+def minibatch_passes(optimiser: torch.optim.Optimizer, data: TensorDict, epochs: int, batch: int,
+                     generator: torch.Generator, loss: Callable[[TensorDict], torch.Tensor],
+                     measured: Callable[[], dict]) -> list[dict]:
+    """`epochs` passes of shuffled minibatch steps of `optimiser` on `loss` over `data`; per pass, the mean
+    training loss and what `measured` returns after it."""
     passes = []
     for _ in tqdm(range(epochs), desc=f"fitting {len(data)} states", unit="pass"):
         order, losses = torch.randperm(len(data), generator=generator), []
         for start in range(0, len(data), batch):
-            loss = mode_distance(actor, data[order[start:start + batch]])
+            value = loss(data[order[start:start + batch]])
             optimiser.zero_grad()
-            loss.backward()
+            value.backward()
             optimiser.step()
-            losses.append(loss.item())
-        with torch.no_grad():
-            passes.append({"train": float(sum(losses) / len(losses)),
-                           "held": mode_distance(actor, held).item() if held is not None else None})
+            losses.append(value.item())
+        passes.append({"train": float(sum(losses) / len(losses)), **measured()})
     return passes
+
+
+def fit(actor, optimiser, data: TensorDict, held: TensorDict | None, epochs: int, batch: int,
+        generator: torch.Generator) -> list[dict]:
+    """`epochs` passes of minibatch Adam on `mode_distance` over `data`; per pass, the mean training loss and
+    the loss on the `held` states (never fitted), if any."""
+    def measured() -> dict:
+        with torch.no_grad():
+            return {"held": mode_distance(actor, held).item() if held is not None else None}
+
+    return minibatch_passes(optimiser, data, epochs, batch, generator,
+                            lambda part: mode_distance(actor, part), measured)
 
 
 def arguments(argv: list[str]) -> argparse.Namespace:

@@ -88,6 +88,31 @@ class Scorer:
                 "start": world.start.as_array().tolist()}
 
 
+class EnvPlanner(Planner):
+    """A flight stepped through an env from the plan's start view: a subclass makes the env (`env`) and picks
+    each action from the state (`act`)."""
+
+    def env(self, world: PlanningWorld, views: int):
+        """The env to fly `views` views in, seeded as the plan (so it starts at the plan's start view)."""
+        raise NotImplementedError
+
+    def act(self, state):
+        """The action to take in `state` (a TensorDict of the env's)."""
+        raise NotImplementedError
+
+    def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
+        """The start view, then the view of each action (13 in all without a count)."""
+        env = self.env(world, views or 13)
+        state = env.reset()
+        if env.viewpoint != world.start:
+            raise RuntimeError(f"{self.name} starts at {env.viewpoint}, the plan at {world.start}")
+        chosen = [env.viewpoint]
+        for _ in range((views or 13) - 1):
+            state = env.step(state.set("action", self.act(state)))["next"]
+            chosen.append(env.viewpoint)
+        return chosen
+
+
 def spread_m(runs: dict[tuple[str, int], dict], scenes: list[str], seeds: list[int]) -> float:
     """Mean distance between the i-th camera positions on two buildings from the same start, metres."""
     paths = {s: {seed: [Viewpoint(*v) for v in runs[s, seed]["viewpoints"]] for seed in seeds}

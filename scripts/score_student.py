@@ -41,7 +41,6 @@ from tqdm import tqdm
 from common.io import atomic_folder, write_json
 from common.provenance import git_commit, portable_record
 from common.threads import set_torch_threads
-from nbv.planning.base import Planner
 from nbv.planning.config import PlanSettings
 from nbv.planning.registry import make_planner
 from nbv.rl.agent import ActorNet
@@ -50,10 +49,10 @@ from nbv.rl.config import EnvConfig, NetworkConfig
 from nbv.rl.env import NBVEnv
 from nbv.rl.expert import CANDIDATES
 from nbv.rl.presets import default_preset
-from render.viewpoint import Viewpoint
 
 sys.path.insert(0, str(Path(__file__).parent))
 import looks_eval  # noqa: E402
+from dagger import minibatch_passes  # noqa: E402
 
 OBSERVATION = ("pixels", "viewpoints", BOV_KEY)
 """The state keys the student reads."""
@@ -120,21 +119,15 @@ def fit(net: ScoreNet, data: TensorDict, held: TensorDict, epochs: int, batch: i
         temperature: float, generator: torch.Generator) -> list[dict]:
     """`epochs` passes of minibatch Adam on the cross-entropy; per pass, the training loss and the held
     states' regret."""
-    optimiser, passes = torch.optim.Adam(net.parameters(), lr=lr), []
-    for _ in tqdm(range(epochs), desc=f"fitting {len(data)} states", unit="pass"):
-        order, losses = torch.randperm(len(data), generator=generator), []
-        for start in range(0, len(data), batch):
-            loss = cross_entropy(net, data[order[start:start + batch]], temperature)
-            optimiser.zero_grad()
-            loss.backward()
-            optimiser.step()
-            losses.append(loss.item())
+    def measured() -> dict:
         held_regret, near = regret(net, held)
-        passes.append({"train": float(np.mean(losses)), "held_regret": held_regret, "held_near_best": near})
-    return passes
+        return {"held_regret": held_regret, "held_near_best": near}
+
+    return minibatch_passes(torch.optim.Adam(net.parameters(), lr=lr), data, epochs, batch, generator,
+                            lambda part: cross_entropy(net, part, temperature), measured)
 
 
-class StudentPlanner(Planner):
+class StudentPlanner(looks_eval.EnvPlanner):
     """The student's flight: an env on the plan's settings, stepped by its highest-valued candidate."""
 
     name = "score-student"
@@ -142,16 +135,14 @@ class StudentPlanner(Planner):
     def __init__(self, net: ScoreNet, blank_images: bool = False) -> None:
         self.net, self.blank_images = net, blank_images
 
-    def plan(self, world, views: int | None) -> list[Viewpoint]:
-        env = NBVEnv(replace(world.env, episode_views=views or 13), seed=world.seed, source=world.source,
-                     blank_images=self.blank_images)
-        state = env.reset()
-        chosen = [env.viewpoint]
-        for _ in range((views or 13) - 1):
-            action = torch.from_numpy(CANDIDATES[choose(self.net, state)]).float()
-            state = env.step(state.set("action", action))["next"]
-            chosen.append(env.viewpoint)
-        return chosen
+    def env(self, world, views: int) -> NBVEnv:
+        """The plan's env (its renders), with blank images if asked."""
+        return NBVEnv(replace(world.env, episode_views=views), seed=world.seed, source=world.source,
+                      blank_images=self.blank_images)
+
+    def act(self, state: TensorDict) -> torch.Tensor:
+        """The candidate step the student values most."""
+        return torch.from_numpy(CANDIDATES[choose(self.net, state)]).float()
 
 
 def merge_blank(results: dict, name: str) -> None:

@@ -22,18 +22,17 @@ from pathlib import Path
 
 from common.io import atomic_folder
 from nbv.experiments.online_acceptance import building_mean
-from nbv.planning.base import Planner
 from nbv.planning.config import PlanSettings
 from nbv.planning.registry import make_planner
 from nbv.rl.config import EnvConfig, RewardConfig
 from nbv.rl.env import NBVEnv
 from nbv.rl.expert import EXPERT_KEY
 from nbv.rl.presets import looks_preset
-from render.viewpoint import Viewpoint
 
 sys.path.insert(0, str(Path(__file__).parent))
 from looks_eval import (  # noqa: E402
     STUDY_OUTPUTS,
+    EnvPlanner,
     evaluate,
     policy_acceptance,
     refuse_held_out,
@@ -43,7 +42,7 @@ from looks_eval import (  # noqa: E402
 )
 
 
-class TeacherPlanner(Planner):
+class TeacherPlanner(EnvPlanner):
     """The teacher's own flight: a training env on the lattice, stepped by its expert action."""
 
     name = "teacher"
@@ -51,18 +50,14 @@ class TeacherPlanner(Planner):
     def __init__(self, trained: EnvConfig, terms: RewardConfig) -> None:
         self.trained, self.terms = trained, terms
 
-    def plan(self, world, views: int | None) -> list[Viewpoint]:
-        config = replace(self.trained, scenes=world.env.scenes, episode_views=views or 13)
-        env = NBVEnv(config, seed=world.seed, reward_terms=self.terms)
-        td = env.reset()
-        if env.viewpoint != world.start:
-            raise RuntimeError(f"the teacher starts at {env.viewpoint}, the plan at {world.start}")
-        chosen = [env.viewpoint]
-        for _ in range((views or 13) - 1):
-            td["action"] = td[EXPERT_KEY]
-            td = env.step(td)["next"]
-            chosen.append(env.viewpoint)
-        return chosen
+    def env(self, world, views: int) -> NBVEnv:
+        """A training env on the building, with the teacher's reward terms."""
+        config = replace(self.trained, scenes=world.env.scenes, episode_views=views)
+        return NBVEnv(config, seed=world.seed, reward_terms=self.terms)
+
+    def act(self, state):
+        """The teacher's label of the state."""
+        return state[EXPERT_KEY]
 
 
 def main() -> None:

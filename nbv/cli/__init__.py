@@ -41,7 +41,7 @@ COMMANDS = {
     "plan": Command("plan", "plan a scan with a planner, reconstruct it and score it"),
     "mission": Command("mission", "write a plan's views as a UAV mission: QGroundControl .plan or KML"),
     "compare": Command("compare", "compare planners over seeds on one scene (table and bar chart)"),
-    "online": Command("online", "both shipped policies (ours, the paper's) vs baselines, held-out buildings"),
+    "online": Command("online", "the shipped policies and the depth option vs baselines, held-out buildings"),
     "plot-training": Command("plot_training", "overlay the learning curves of training runs"),
     "demo": Command("demo", "scan, refine, reconstruct and evaluate a built-in scene"),
     "ablate": Command("ablate", "rendering-quality ablations, one axis at a time (make ablations)"),

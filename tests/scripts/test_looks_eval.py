@@ -2,8 +2,13 @@
 
 from __future__ import annotations
 
-import pytest
+from types import SimpleNamespace
 
+import pytest
+import torch
+from tensordict import TensorDict
+
+from render.viewpoint import Viewpoint
 from scripts import looks_eval as module
 
 
@@ -55,3 +60,38 @@ def test_report_counts_the_checks_and_lists_them():
     assert "| orbit | 90.2 | +0.0 | +0.0 | 9.0 | 0.00 | - | - | 90.0 | 90.5 |" in table
     assert "| mean coverage minus the tuned orbit's, points | >= +3.0 | +2.8 (no) |" in table
     assert "| **every check** |  | **no** |" in table
+
+
+class StepEnv:
+    """An env on a line: each action (a number) moves the view's azimuth by that much."""
+
+    def __init__(self, start: float) -> None:
+        self.viewpoint = Viewpoint(2.0, start, 0.3)
+
+    def reset(self) -> TensorDict:
+        return TensorDict({"steps": 0})
+
+    def step(self, state: TensorDict) -> TensorDict:
+        self.viewpoint = Viewpoint(2.0, self.viewpoint.azimuth + float(state["action"]), 0.3)
+        return state.set("next", state.clone().set("steps", int(state["steps"]) + 1))
+
+
+class Walker(module.EnvPlanner):
+    name = "walker"
+
+    def __init__(self, start: float) -> None:
+        self.start = start
+
+    def env(self, world, views):
+        return StepEnv(self.start)
+
+    def act(self, state: TensorDict) -> torch.Tensor:
+        return torch.tensor(0.5 + int(state["steps"]))  # 0.5, then 1.5, 2.5, ...
+
+
+def test_an_env_planner_flies_its_actions_from_the_plans_start_and_refuses_another():
+    world = SimpleNamespace(start=Viewpoint(2.0, 0.0, 0.3))
+    assert [v.azimuth for v in Walker(0.0).plan(world, 3)] == [0.0, 0.5, 2.0]
+    assert len(Walker(0.0).plan(world, None)) == 13
+    with pytest.raises(RuntimeError, match="walker starts at .* the plan at"):
+        Walker(1.0).plan(world, 3)

@@ -287,8 +287,9 @@ INDEX = (
            "preset's against the baselines, 13 views, five held-out buildings, one pass",
            "nbv online (command in the file)"),
     Result("online/acceptance/online.md", "online/acceptance/online.json", "issue 26's acceptance, check by "
-           "check: the shipped policies against random views and the tuned orbits, with blank images, on "
-           "eight held-out buildings (three of the trait family)", "nbv online (command in the file)"),
+           "check: the shipped policies and the depth option (lookahead) against random views and the tuned "
+           "orbits, with blank images, on eight held-out buildings (three of the trait family)",
+           "nbv online (command in the file)"),
     Result("ablations/README.md", "ablations/ablations.json", "rendering-quality ablations, one axis at a "
            "time", "make ablations"),
     Result("planners/README.md", "planners/comparison.json", "early planner comparison on the held-out "

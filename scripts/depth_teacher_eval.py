@@ -32,6 +32,8 @@ def main() -> None:
     parser.add_argument("--flight-reward", type=float, nargs="+", default=[0.05])
     parser.add_argument("--grid-resolution", type=int, default=32, help="voxels along the longest side")
     parser.add_argument("--gain-ray-stride", type=int, default=8, help="every n-th pixel's ray, both axes")
+    parser.add_argument("--distinct", action="store_true",
+                        help="also fly each weight never stepping onto a view already flown (name ending _d)")
     looks_eval.study_arguments(parser)
     args = parser.parse_args()
     looks_eval.refuse_held_out(args.scenes)
@@ -41,8 +43,10 @@ def main() -> None:
     names = []
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"
-        planners[name] = (LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays), False)
-        names.append(name)
+        for distinct in (False, True) if args.distinct else (False,):
+            planner = LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays, distinct=distinct)
+            planners[name + "_d" * distinct] = (planner, False)
+            names.append(name + "_d" * distinct)
     results = looks_eval.evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work)
     checks = looks_eval.policy_acceptance(results, args.scenes, names)
     table = looks_eval.report(results, args.scenes, args.seeds, args.views, "orbit", checks)

@@ -34,7 +34,7 @@ from nbv.planning.infogain import target_grid
 from nbv.recon.config import OccupancyConfig
 from nbv.recon.occupancy import UNKNOWN
 from nbv.rl.env import action_to_viewpoint
-from nbv.rl.expert import best_action, expert_scores
+from nbv.rl.expert import CANDIDATES, best_action, expert_scores
 from nbv.rl.presets import ORBIT_STEP
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 
@@ -58,11 +58,15 @@ class LookaheadPlanner(Planner):
     name = "lookahead"
 
     def __init__(self, flight: float = LOOKAHEAD_FLIGHT, grid: int = LOOKAHEAD_GRID,
-                 rays: int = LOOKAHEAD_RAYS, default_views: int = 13) -> None:
+                 rays: int = LOOKAHEAD_RAYS, default_views: int = 13, distinct: bool = False) -> None:
+        """The flight weight a metre, the grid's voxels along its longest side, the rays across the image;
+        `distinct`: never step onto a view already flown (else staying put may win where the flight costs
+        more than the grid says is left)."""
         if not 0 <= flight < float("inf") or grid < 1 or rays < 1:
             raise ValueError(f"lookahead needs a finite flight weight >= 0, grid >= 1 and rays >= 1, got "
                              f"{flight}, {grid}, {rays}")
         self.flight, self.grid, self.rays, self.default_views = flight, grid, rays, default_views
+        self.distinct = distinct
 
     def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """The start view, then each next one the orbit step whose look-ahead on the grid scores best."""
@@ -84,9 +88,22 @@ class LookaheadPlanner(Planner):
             known = grid.state.reshape(-1) != UNKNOWN
             scores = expert_scores(view, known, sees, step, self.flight, left, HORIZON, DISCOUNT,
                                    flown_m=shell_path(chosen[0], chosen[1:]).total_m)
+            if self.distinct:
+                repeats = np.array([revisits(step(action, view), chosen) for action in CANDIDATES])
+                scores = np.where(repeats, -np.inf, scores) if not repeats.all() else scores
             view = step(best_action(scores), view)
             chosen.append(view)
         return chosen
+
+
+def revisits(view: Viewpoint, flown: list[Viewpoint], tolerance: float = 1e-6) -> bool:
+    """Whether `view` is one of the views `flown` (radius, azimuth across 2 pi, elevation within
+    `tolerance`)."""
+    def turn(a: float, b: float) -> float:
+        return abs((a - b + np.pi) % (2 * np.pi) - np.pi)
+
+    return any(abs(view.radius - f.radius) <= tolerance and turn(view.azimuth, f.azimuth) <= tolerance
+               and abs(view.elevation - f.elevation) <= tolerance for f in flown)
 
 
 def lookahead_planner(settings: PlanSettings, seed: int, argument: str | None) -> LookaheadPlanner:

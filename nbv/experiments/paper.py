@@ -344,6 +344,9 @@ INDEX = (
     Result("selection/round23/README.md", "selection/round23/privileged_seed1/results.json", "its "
            "twenty-third round: the teacher's knowledge in the student's state, and a student that ranks the "
            "teacher's steps", LOOKS_EVAL),
+    Result("selection/round24/README.md", "selection/round24/lookahead_distinct/results.json", "its "
+           "twenty-fourth round: the depth option's look-ahead never repeating a view (not adopted)",
+           LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

@@ -11,12 +11,13 @@ import pytest
 
 from nbv.flight.path import shell_path
 from nbv.planning.config import PlanSettings
-from nbv.planning.lookahead import LOOKAHEAD_FLIGHT, LookaheadPlanner, lookahead_planner
+from nbv.planning.lookahead import LOOKAHEAD_FLIGHT, LookaheadPlanner, lookahead_planner, revisits
 from nbv.planning.registry import make_planner
 from nbv.planning.world import PlanningWorld
 from nbv.rl.env import action_to_viewpoint
 from nbv.rl.expert import CANDIDATES
 from nbv.rl.presets import ORBIT_STEP
+from render.viewpoint import Viewpoint
 from tests.nbv.rl.test_bov_observation import config
 
 
@@ -42,6 +43,24 @@ def test_a_dear_flight_takes_the_shortest_leg():
     views = LookaheadPlanner(flight=1e5, grid=16, rays=8).plan(world, 2)
     legs = [shell_path(world.start, [s]).total_m for s in steps_from(world.start, env)]
     assert shell_path(world.start, views[1:]).total_m == min(legs)
+
+
+def test_a_distinct_flight_never_repeats_a_view_where_staying_put_costs_least():
+    world = PlanningWorld(config(), seed=3)
+    stays = LookaheadPlanner(flight=1e5, grid=16, rays=8).plan(world, 4)
+    assert stays[1] == stays[2] == stays[3]  # on the steps' levels, staying put is a step, and free
+    views = LookaheadPlanner(flight=1e5, grid=16, rays=8, distinct=True).plan(world, 4)
+    assert views[1] == stays[1] and not any(revisits(view, views[:i]) for i, view in enumerate(views) if i)
+    moves = [shell_path(views[1], [s]).total_m for s in steps_from(views[1], world.env)
+             if not revisits(s, views[:2])]
+    assert shell_path(views[1], views[2:3]).total_m == pytest.approx(min(moves))  # the shortest move
+
+
+def test_revisits_matches_views_across_the_azimuth_seam_only():
+    seam = [Viewpoint(2.0, 2 * np.pi - 1e-8, 0.3)]
+    assert revisits(Viewpoint(2.0, 1e-8, 0.3), seam)
+    assert not revisits(Viewpoint(2.0, 1e-3, 0.3), seam)
+    assert not revisits(Viewpoint(2.1, 1e-8, 0.3), seam) and not revisits(Viewpoint(2.0, 0.0, 0.31), seam)
 
 
 def test_the_spec_sets_the_flight_weight_and_refuses_bad_ones():

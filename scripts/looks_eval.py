@@ -26,6 +26,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from abc import abstractmethod
 from pathlib import Path
 
 import numpy as np
@@ -92,13 +93,13 @@ class EnvPlanner(Planner):
     """A flight stepped through an env from the plan's start view: a subclass makes the env (`env`) and picks
     each action from the state (`act`)."""
 
+    @abstractmethod
     def env(self, world: PlanningWorld, views: int):
         """The env to fly `views` views in, seeded as the plan (so it starts at the plan's start view)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def act(self, state):
         """The action to take in `state` (a TensorDict of the env's)."""
-        raise NotImplementedError
 
     def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """The start view, then the view of each action (13 in all without a count)."""

@@ -135,7 +135,7 @@ def run_online(config: OnlineConfig) -> str:
         found[comparison.scene.scene] = _runs(comparison.out)
     policy = planner_label(config.policies[0])
     checks = acceptance_checks(budget, blank or None, [planner_label(spec) for spec in config.policies],
-                               [planner_label(spec) for spec in config.depth_options])
+                               depth_labels(config))
     coverage = {label: mean_coverage(budget, label) for label in next(iter(budget.values()))}
     text = online_report(budget, coverage, one_pass, policy, config, checks)
     record = portable_record(config_record(config, omit=("executor",)))
@@ -147,6 +147,11 @@ def run_online(config: OnlineConfig) -> str:
         write_json(folder / "online.json", {"commit": git_commit(), "config": record, "budget": budget,
                                             "one_pass": one_pass, "blank": blank, "acceptance": checks})
     return text
+
+
+def depth_labels(config: OnlineConfig) -> list[str]:
+    """The depth options' planner labels, as the runs and the acceptance name them."""
+    return [planner_label(spec) for spec in config.depth_options]
 
 
 def rerun_command(config: OnlineConfig) -> str:
@@ -177,7 +182,7 @@ def online_report(budget: dict[str, dict[str, list[dict]]], coverage: dict[str, 
     """The Markdown report: 13-view coverage per building (`coverage`, by planner label, `mean_coverage`)
     with the policy's margins, then one pass, then the acceptance checks (`checks`, by policy)."""
     labels = list(coverage)
-    depth = [planner_label(spec) for spec in config.depth_options]
+    depth = depth_labels(config)
     rows = [[scene, *(f"{coverage[label][scene]:.1f}" for label in labels)] for scene in budget]
     overall = {label: building_mean(by) for label, by in coverage.items()}
     rows.append(["**mean**", *(f"**{overall[label]:.1f}**" for label in labels)])
@@ -214,7 +219,7 @@ def online_report(budget: dict[str, dict[str, list[dict]]], coverage: dict[str, 
     if one_pass:
         lines += ["", "## One pass around the target (the paper's protocol), against the full 288-view scan",
                   "", _one_pass_table(one_pass, policies)]
-    lines += acceptance_section(checks, len(budget), [planner_label(spec) for spec in config.depth_options])
+    lines += acceptance_section(checks, len(budget), depth)
     if config.sfm:
         lines += _sfm_section(budget, one_pass, config.views)
     return "\n".join(lines) + "\n"

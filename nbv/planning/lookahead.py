@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from nbv.flight.path import shell_path
+from nbv.flight.path import azimuth_step, shell_path
 from nbv.planning.base import Planner
 from nbv.planning.infogain import target_grid
 from nbv.recon.config import OccupancyConfig
@@ -99,11 +99,8 @@ class LookaheadPlanner(Planner):
 def revisits(view: Viewpoint, flown: list[Viewpoint], tolerance: float = 1e-6) -> bool:
     """Whether `view` is one of the views `flown` (radius, azimuth across 2 pi, elevation within
     `tolerance`)."""
-    def turn(a: float, b: float) -> float:
-        return abs((a - b + np.pi) % (2 * np.pi) - np.pi)
-
-    return any(abs(view.radius - f.radius) <= tolerance and turn(view.azimuth, f.azimuth) <= tolerance
-               and abs(view.elevation - f.elevation) <= tolerance for f in flown)
+    return any(abs(view.radius - f.radius) <= tolerance and abs(view.elevation - f.elevation) <= tolerance
+               and abs(azimuth_step(f.azimuth, view.azimuth)) <= tolerance for f in flown)
 
 
 def lookahead_planner(settings: PlanSettings, seed: int, argument: str | None) -> LookaheadPlanner:

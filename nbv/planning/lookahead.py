@@ -19,6 +19,12 @@ coverage than the tuned ring there, at least 0.4 more on every building, in 1.39
 metre flew 1.51x on the second three). `lookahead:W` flies another flight weight W (coverage points a
 metre). Held out, scored once (paper_results/online/acceptance, `nbv online --depth-options lookahead`):
 4.2 points above the ring in 1.13x its metres, 5.1 under it on the walled compound.
+
+`lookahead-stereo` runs the same look-ahead on what a camera alone measures: at each view the UAV takes a
+second frame `STEREO_BASELINE_M` along its orbit (a step sideways, as a frame of its flight video), and
+plane-sweep stereo between the two (`nbv.recon.stereo`) gives both frames' depth where it finds a
+consistent match; only that depth is fused, the rest stays unknown. It reads images and the poses flown
+(and the target's box), so it is held to every check of the policies, the blank-images one included.
 """
 
 from __future__ import annotations
@@ -32,7 +38,8 @@ from nbv.flight.path import azimuth_step, shell_path
 from nbv.planning.base import Planner
 from nbv.planning.infogain import target_grid
 from nbv.recon.config import OccupancyConfig
-from nbv.recon.occupancy import UNKNOWN
+from nbv.recon.occupancy import UNKNOWN, OccupancyGrid
+from nbv.recon.stereo import StereoConfig, box_depth_range, grayscale, two_view_depth
 from nbv.rl.env import action_to_viewpoint
 from nbv.rl.expert import CANDIDATES, best_action, expert_scores
 from nbv.rl.presets import ORBIT_STEP
@@ -50,6 +57,11 @@ LOOKAHEAD_FLIGHT = 0.07
 """The flight cost, coverage points (of the grid's voxels) a metre along the viewing shell."""
 HORIZON, DISCOUNT = 3, 0.9
 """Views scored ahead per candidate step, and the weight a step further (the teacher's defaults)."""
+STEREO_BASELINE_M = 0.25
+"""How far along the orbit `lookahead-stereo` takes each view's second frame, metres (a training building's
+choice, scripts/stereo_depth_eval.py)."""
+DEPTH_SOURCES = ("camera", "stereo")
+"""Where the look-ahead's depth comes from: a depth camera, or plane-sweep stereo on two frames a view."""
 
 
 class LookaheadPlanner(Planner):
@@ -58,15 +70,19 @@ class LookaheadPlanner(Planner):
     name = "lookahead"
 
     def __init__(self, flight: float = LOOKAHEAD_FLIGHT, grid: int = LOOKAHEAD_GRID,
-                 rays: int = LOOKAHEAD_RAYS, default_views: int = 13, distinct: bool = False) -> None:
+                 rays: int = LOOKAHEAD_RAYS, default_views: int = 13, distinct: bool = False,
+                 depth: str = "camera", blank_images: bool = False) -> None:
         """The flight weight a metre, the grid's voxels along its longest side, the rays across the image;
         `distinct`: never step onto a view already flown (else staying put may win where the flight costs
-        more than the grid says is left)."""
-        if not 0 <= flight < float("inf") or grid < 1 or rays < 1:
-            raise ValueError(f"lookahead needs a finite flight weight >= 0, grid >= 1 and rays >= 1, got "
-                             f"{flight}, {grid}, {rays}")
+        more than the grid says is left); `depth`: one of `DEPTH_SOURCES`; `blank_images`: with stereo,
+        every captured frame replaced by a blank one (the evaluation's test that it looks)."""
+        if not 0 <= flight < float("inf") or grid < 1 or rays < 1 or depth not in DEPTH_SOURCES:
+            raise ValueError(f"lookahead needs a finite flight weight >= 0, grid >= 1, rays >= 1 and depth "
+                             f"from {DEPTH_SOURCES}, got {flight}, {grid}, {rays}, {depth!r}")
         self.flight, self.grid, self.rays, self.default_views = flight, grid, rays, default_views
-        self.distinct = distinct
+        self.distinct, self.depth, self.blank_images = distinct, depth, blank_images
+        if depth == "stereo":
+            self.name = "lookahead-stereo"
 
     def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """The start view, then each next one the orbit step whose look-ahead on the grid scores best."""
@@ -83,8 +99,7 @@ class LookaheadPlanner(Planner):
 
         view, chosen = world.start, [world.start]
         for left in range((self.default_views if views is None else views) - 1, 0, -1):
-            grid.integrate(world.source.render_depth(view), camera.K, viewpoint_to_c2w(view, center),
-                           OccupancyConfig().integrate_ray_stride)
+            self.measure(world, grid, view)
             known = grid.state.reshape(-1) != UNKNOWN
             scores = expert_scores(view, known, sees, step, self.flight, left, HORIZON, DISCOUNT,
                                    flown_m=shell_path(chosen[0], chosen[1:]).total_m)
@@ -94,6 +109,31 @@ class LookaheadPlanner(Planner):
             view = step(best_action(scores), view)
             chosen.append(view)
         return chosen
+
+
+    def measure(self, world: PlanningWorld, grid: OccupancyGrid, view: Viewpoint) -> None:
+        """Fuse what the UAV measures at `view` into the grid: the depth camera's image, or stereo depth of
+        the view and its second frame."""
+        camera, center, stride = world.camera, world.target.center(), OccupancyConfig().integrate_ray_stride
+        if self.depth == "camera":
+            grid.integrate(world.source.render_depth(view), camera.K, viewpoint_to_c2w(view, center), stride)
+            return
+        frames = (view, stereo_partner(view))
+        poses = [viewpoint_to_c2w(v, center) for v in frames]
+        images = [np.zeros((camera.height, camera.width)) if self.blank_images
+                  else grayscale(world.source.render_rgb(v)) for v in frames]
+        ranges = [box_depth_range(grid.lower, grid.upper, pose) for pose in poses]
+        near, far = min(r[0] for r in ranges), max(r[1] for r in ranges)
+        depths = two_view_depth(*images, camera.K, *poses, near, far, StereoConfig())
+        for depth, pose in zip(depths, poses, strict=True):
+            grid.integrate(depth, camera.K, pose, stride)
+
+
+def stereo_partner(view: Viewpoint, baseline: float = STEREO_BASELINE_M) -> Viewpoint:
+    """The view's second frame: `baseline` metres (a chord) back along its orbit, at its radius and
+    elevation."""
+    horizontal = max(view.radius * np.cos(view.elevation), baseline)
+    return Viewpoint(view.radius, view.azimuth - 2 * np.arcsin(baseline / (2 * horizontal)), view.elevation)
 
 
 def revisits(view: Viewpoint, flown: list[Viewpoint], tolerance: float = 1e-6) -> bool:
@@ -107,8 +147,19 @@ def lookahead_planner(settings: PlanSettings, seed: int, argument: str | None) -
     """The registry's `lookahead`: the validated setting, or `lookahead:W` with flight weight W a metre."""
     if argument is None:
         return LookaheadPlanner()
+    return LookaheadPlanner(flight=flight_weight(argument))
+
+
+def stereo_lookahead_planner(settings: PlanSettings, seed: int, argument: str | None) -> LookaheadPlanner:
+    """The registry's `lookahead-stereo`: the look-ahead on stereo depth from two frames a view (the
+    validated weight, or `lookahead-stereo:W`)."""
+    flight = LOOKAHEAD_FLIGHT if argument is None else flight_weight(argument)
+    return LookaheadPlanner(flight=flight, depth="stereo", blank_images=settings.blank_images)
+
+
+def flight_weight(argument: str) -> float:
+    """The flight weight a metre that `lookahead:W` gives."""
     try:
-        flight = float(argument)
+        return float(argument)
     except ValueError:
         raise ValueError(f"lookahead:W takes a flight weight a metre, got {argument!r}") from None
-    return LookaheadPlanner(flight=flight)

@@ -105,6 +105,11 @@ PLANNERS: tuple[PlannerEntry, ...] = (
                  "of an occupancy grid fused from the depth flown, less 0.07 a metre flown (lookahead:W "
                  "another weight)", "nbv.planning.lookahead:lookahead_planner", argument="W", budget=False,
                  depth_option=True),
+    PlannerEntry("lookahead-stereo", "the same look-ahead on what a camera alone measures: the grid fused "
+                 "from plane-sweep stereo depth of each view and a second frame 0.25 m along its orbit "
+                 "(reads images and poses, as the policies do; lookahead-stereo:W another weight)",
+                 "nbv.planning.lookahead:stereo_lookahead_planner", settings=("blank_images",), argument="W",
+                 budget=False),
     PlannerEntry("policy", "a trained actor (a `nbv train` checkpoint.pt or policy.pt; none: the shipped "
                  "policy) from the start view, acting on its distribution's mode",
                  "nbv.planning.policy:policy_planner", settings=("blank_images",), checkpoint=True),

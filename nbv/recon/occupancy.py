@@ -8,7 +8,8 @@ probabilistic:
 
 - `integrate`: every voxel a captured pixel's ray crosses before its hit becomes
   free; the voxel holding the hit becomes occupied. A pixel with depth 0 (no
-  hit in range) carves free space through the whole grid. Occupied wins over
+  hit in range) carves free space through the whole grid; a NaN pixel (not measured: stereo that found
+  no match, `nbv.recon.stereo`) casts no ray and marks nothing. Occupied wins over
   free, now and later: a ray grazing a voxel that holds surface seen elsewhere
   does not clear it (log-odds maps weigh the two; a ternary map must choose).
 - `gain`: the number of distinct unknown voxels a candidate camera's rays reach,
@@ -70,18 +71,23 @@ class OccupancyGrid:
 
     def integrate(self, depth: np.ndarray, K: np.ndarray, c2w: np.ndarray,  # noqa: N803
                   stride: int = 1) -> None:
-        """Fold in one z-depth image (H x W metres, 0 for no hit) taken at the OpenCV camera-to-world `c2w`.
+        """Fold in one z-depth image (H x W metres, 0 for no hit, NaN for not measured) taken at the OpenCV
+        camera-to-world `c2w`.
 
-        Free space is carved along every `stride`-th pixel's ray; every pixel's hit is marked occupied.
+        Free space is carved along every `stride`-th measured pixel's ray; every pixel's hit is marked
+        occupied.
         """
         depth = np.asarray(depth, dtype=np.float64)
         origin, rays = self._rays(K, c2w, depth.shape[1], depth.shape[0])
         lengths = np.linalg.norm(rays, axis=-1)
         ranges = np.where(depth > 0, depth * lengths, np.inf)  # z-depth to distance along the unit ray
         step = slice(None, None, stride)
-        sub_rays, sub_ranges = rays[step, step].reshape(-1, 3), ranges[step, step].reshape(-1)
+        measured = np.isfinite(depth[step, step]).reshape(-1)
+        sub_rays = rays[step, step].reshape(-1, 3)[measured]
+        sub_ranges = ranges[step, step].reshape(-1)[measured]
+        lengths = lengths[step, step].reshape(-1, 1)[measured]
         flat = self.state.reshape(-1)
-        for index, valid in self._walk(origin, sub_rays / lengths[step, step].reshape(-1, 1), sub_ranges):
+        for index, valid in self._walk(origin, sub_rays / lengths, sub_ranges):
             free = index[valid]
             flat[free[flat[free] != OCCUPIED]] = FREE
         hits = origin + rays[depth > 0] * depth[depth > 0, None]

@@ -1,0 +1,159 @@
+"""Depth from two calibrated views by plane sweep: what a camera-only UAV measures (`lookahead-stereo`).
+
+Plane-sweep stereo (Collins, CVPR 1996; Gallup et al., CVPR 2007): for every pixel of the reference image
+and each of D fronto-parallel depth hypotheses, spaced evenly in inverse depth between `near` and `far`,
+the point the pixel would see at that depth is projected into the source image and sampled there; the
+hypothesis whose square window correlates best (zero-mean normalised cross-correlation, NCC) wins, refined
+between hypotheses by a parabola through the best and its two neighbours. A pixel keeps its depth only
+where its window has texture, the best correlation reaches `min_correlation`, the winner is not at either
+end of the sweep, and the source's own sweep, projected back, agrees within `consistency` (a left-right
+check, which removes occlusions and most false matches of repeated texture). Every other pixel is NaN:
+not measured, which `OccupancyGrid.integrate` skips (neither carved nor marked), unlike depth 0 (no hit).
+
+Images are grayscale floats in [0, 1]; depth is z-depth in metres (docs/conventions.md); poses are OpenCV
+camera-to-world (x right, y down, z forward); both views share the intrinsics K. Torch, on the CPU.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+import torch.nn.functional as F  # noqa: N812
+
+from render.camera import pixel_rays
+from render.viewpoint import validate_pose
+
+
+@dataclass(frozen=True)
+class StereoConfig:
+    """Plane-sweep settings, chosen on a training building (`scripts/stereo_depth_eval.py`)."""
+
+    hypotheses: int = 96
+    """Depth hypotheses between near and far, evenly spaced in inverse depth."""
+    window: int = 7
+    """Side of the square correlation window, pixels (odd)."""
+    min_correlation: float = 0.7
+    """Least NCC of the best hypothesis for a pixel to keep its depth."""
+    min_texture: float = 0.02
+    """Least standard deviation of intensity (0 to 1) in a window, in the reference and the sampled source,
+    for the window to be matched at all (the uniform sky and blank images have none)."""
+    consistency: float = 0.02
+    """Largest relative disagreement between the two views' depths of one point (the left-right check)."""
+
+    def __post_init__(self) -> None:
+        if self.hypotheses < 3 or self.window < 1 or self.window % 2 == 0:
+            raise ValueError(f"stereo needs >= 3 hypotheses and an odd window, got {self.hypotheses}, "
+                             f"{self.window}")
+        if not (-1 <= self.min_correlation <= 1 and self.min_texture >= 0 and self.consistency > 0):
+            raise ValueError(f"stereo needs min_correlation in [-1, 1], min_texture >= 0 and consistency "
+                             f"> 0, got {self.min_correlation}, {self.min_texture}, {self.consistency}")
+
+
+def grayscale(rgb: np.ndarray) -> np.ndarray:
+    """(H, W) float32 luminance in [0, 1] (Rec. 601 weights) of an sRGB uint8 image (H, W, 3)."""
+    return (np.asarray(rgb, np.float32)[..., :3] @ np.array([0.299, 0.587, 0.114], np.float32)) / 255.0
+
+
+def box_depth_range(lower: np.ndarray, upper: np.ndarray, c2w: np.ndarray) -> tuple[float, float]:
+    """The least and greatest z-depth of an axis-aligned box's corners from a camera at `c2w` (near clipped
+    to 5 cm): the depths between which a surface inside the box can lie."""
+    corners = np.array([[x, y, z] for x in (lower[0], upper[0]) for y in (lower[1], upper[1])
+                        for z in (lower[2], upper[2])], np.float64)
+    pose = validate_pose(c2w)
+    z = (corners - pose[:3, 3]) @ pose[:3, 2]
+    return max(float(z.min()), 0.05), max(float(z.max()), 0.1)
+
+
+def _window_stats(x: torch.Tensor, window: int) -> tuple[torch.Tensor, torch.Tensor]:
+    """Mean and variance of (N, H, W) images over square windows (the window shrinks at the border)."""
+    def pool(t: torch.Tensor) -> torch.Tensor:
+        return F.avg_pool2d(t[:, None], window, 1, window // 2, count_include_pad=False)[:, 0]
+    mean = pool(x)
+    return mean, (pool(x * x) - mean * mean).clamp(min=0.0)
+
+
+def _project(depth: torch.Tensor, K: np.ndarray, ref_c2w: np.ndarray,  # noqa: N803
+             src_c2w: np.ndarray, width: int, height: int) -> tuple[torch.Tensor, torch.Tensor]:
+    """Where the reference pixels at z-depths `depth` (..., H, W) land in the source: pixel (u, v) and
+    z-depth, (..., H, W, 2) and (..., H, W)."""
+    relative = np.linalg.inv(validate_pose(src_c2w)) @ validate_pose(ref_c2w)
+    rays = torch.as_tensor(pixel_rays(K, width, height) @ relative[:3, :3].T, dtype=torch.float32)
+    cam = depth[..., None] * rays + torch.as_tensor(relative[:3, 3], dtype=torch.float32)
+    z = cam[..., 2]
+    pixels = cam @ torch.as_tensor(np.asarray(K, np.float64).T, dtype=torch.float32)
+    return pixels[..., :2] / z.clamp(min=1e-9)[..., None], z
+
+
+def _sample(image: torch.Tensor, uv: torch.Tensor) -> torch.Tensor:
+    """Bilinear samples of an (H, W) image at pixel coordinates uv (N, H, W, 2), pixel centres at integers."""
+    height, width = image.shape
+    scale = torch.tensor([2.0 / width, 2.0 / height])
+    grid = (uv + 0.5) * scale - 1.0
+    return F.grid_sample(image.expand(len(uv), 1, height, width), grid, align_corners=False,
+                         padding_mode="border")[:, 0]
+
+
+def sweep(ref: np.ndarray, src: np.ndarray, K: np.ndarray, ref_c2w: np.ndarray,  # noqa: N803
+          src_c2w: np.ndarray, near: float, far: float,
+          config: StereoConfig = StereoConfig()) -> tuple[np.ndarray, np.ndarray]:
+    """Per reference pixel, the refined best z-depth of the sweep and its NCC ((H, W) each; NaN and -1
+    where no hypothesis could be matched or the best lies at an end of the sweep)."""
+    if not 0 < near < far:
+        raise ValueError(f"plane sweep needs 0 < near < far, got {near}, {far}")
+    reference, source = (torch.as_tensor(np.asarray(x, np.float32)) for x in (ref, src))
+    height, width = reference.shape
+    inverse = torch.linspace(1.0 / near, 1.0 / far, config.hypotheses)
+    uv, z = _project(1.0 / inverse[:, None, None].expand(-1, height, width), K, ref_c2w, src_c2w, width,
+                     height)
+    warped = _sample(source, uv)
+    ref_mean, ref_var = _window_stats(reference[None], config.window)
+    src_mean, src_var = _window_stats(warped, config.window)
+    cross = F.avg_pool2d((reference[None] * warped)[:, None], config.window, 1, config.window // 2,
+                         count_include_pad=False)[:, 0] - ref_mean * src_mean
+    ncc = cross / torch.sqrt((ref_var * src_var).clamp(min=1e-12))
+    inside = (z > 0) & (uv[..., 0] >= 0) & (uv[..., 0] <= width - 1) & (uv[..., 1] >= 0) & \
+        (uv[..., 1] <= height - 1)
+    textured = (ref_var >= config.min_texture ** 2) & (src_var >= config.min_texture ** 2)
+    ncc = torch.where(inside & textured, ncc, torch.tensor(-1.0))
+    best, index = ncc.max(dim=0)
+    interior = (index > 0) & (index < config.hypotheses - 1) & (best > -1)
+    lower, upper = (ncc.gather(0, (index + k).clamp(0, config.hypotheses - 1)[None])[0] for k in (-1, 1))
+    curvature = lower - 2 * best + upper
+    offset = torch.where(curvature < 0, 0.5 * (lower - upper) / curvature.clamp(max=-1e-9),
+                         torch.tensor(0.0)).clamp(-0.5, 0.5)
+    step = inverse[1] - inverse[0]
+    depth = 1.0 / (inverse[index] + offset * step)
+    depth = torch.where(interior, depth, torch.tensor(float("nan")))
+    return depth.numpy(), torch.where(interior, best, torch.tensor(-1.0)).numpy()
+
+
+def _consistent(depth: np.ndarray, other: np.ndarray, K: np.ndarray, c2w: np.ndarray,  # noqa: N803
+                other_c2w: np.ndarray, tolerance: float) -> np.ndarray:
+    """Where `depth`'s points, projected into the other view, meet that view's depth within a relative
+    `tolerance` (at the nearest pixel)."""
+    height, width = depth.shape
+    uv, z = _project(torch.as_tensor(np.nan_to_num(depth, nan=1.0), dtype=torch.float32), K, c2w, other_c2w,
+                     width, height)
+    u, v = (torch.round(uv[..., i]).long().numpy() for i in (0, 1))
+    z = z.numpy()
+    inside = np.isfinite(depth) & (z > 0) & (u >= 0) & (u < width) & (v >= 0) & (v < height)
+    seen = np.full(depth.shape, np.nan, np.float32)
+    seen[inside] = other[v[inside], u[inside]]
+    with np.errstate(invalid="ignore"):
+        return inside & (np.abs(seen - z) <= tolerance * z)
+
+
+def two_view_depth(ref: np.ndarray, src: np.ndarray, K: np.ndarray, ref_c2w: np.ndarray,  # noqa: N803
+                   src_c2w: np.ndarray, near: float, far: float,
+                   config: StereoConfig = StereoConfig()) -> tuple[np.ndarray, np.ndarray]:
+    """Both views' z-depth (H, W) float32 metres, NaN where not measured: each view swept against the
+    other, kept where textured, correlated and consistent (module docstring)."""
+    first, first_ncc = sweep(ref, src, K, ref_c2w, src_c2w, near, far, config)
+    second, second_ncc = sweep(src, ref, K, src_c2w, ref_c2w, near, far, config)
+    first = np.where(first_ncc >= config.min_correlation, first, np.nan).astype(np.float32)
+    second = np.where(second_ncc >= config.min_correlation, second, np.nan).astype(np.float32)
+    keep_first = _consistent(first, second, K, ref_c2w, src_c2w, config.consistency)
+    keep_second = _consistent(second, first, K, src_c2w, ref_c2w, config.consistency)
+    return np.where(keep_first, first, np.nan), np.where(keep_second, second, np.nan)

@@ -1,0 +1,110 @@
+"""How well plane-sweep stereo measures a building's depth from two frames (round 25; training buildings).
+
+`lookahead-stereo` (`nbv.planning.lookahead`) fuses the depth that plane-sweep stereo (`nbv.recon.stereo`)
+finds between each view and a second frame a short step along its orbit. This study chooses that step (the
+baseline, metres) and the sweep's settings: on training buildings, from random views of the default preset's
+ranges and camera (160 x 120, its render settings), each setting's depth of the view is compared with the
+renderer's exact depth on the pixels whose surface lies inside the target's box (what the look-ahead's grid
+holds):
+
+- measured: the share of those pixels that keep a depth;
+- median error: of the kept depths, relative to the exact one;
+- wrong: the share of kept depths more than 5 % off (they mark the wrong voxel occupied).
+
+The rule, set before the run: the setting and baseline that measure the most pixels with at most 5 % of
+them wrong.
+
+    python scripts/stereo_depth_eval.py --baselines 0.15 0.25 0.4 --out OUT
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from common.io import atomic_folder, markdown_table, write_json, write_text
+from common.provenance import git_commit, portable_record
+from nbv.planning.lookahead import stereo_partner
+from nbv.planning.world import PlanningWorld
+from nbv.recon.stereo import StereoConfig, box_depth_range, grayscale, two_view_depth
+from nbv.rl.presets import TRAIN_SCENES, default_preset
+from nbv.rl.validate import evaluation_env_config
+from render.camera import pixel_rays
+from render.viewpoint import draw_viewpoint, viewpoint_to_c2w
+from scenes.family_splits import held_out
+from scenes.spec import SceneSet
+
+VARIANTS = {"default": {}, "window 9": {"window": 9}, "window 5": {"window": 5},
+            "ncc 0.6": {"min_correlation": 0.6}, "ncc 0.8": {"min_correlation": 0.8},
+            "consistency 0.01": {"consistency": 0.01}, "192 hypotheses": {"hypotheses": 192},
+            "window 9, ncc 0.6": {"window": 9, "min_correlation": 0.6}}
+"""The sweep settings tried, as changes to `StereoConfig`'s defaults."""
+
+
+def score_view(world: PlanningWorld, view, baseline: float, configs: dict[str, StereoConfig]) -> dict:
+    """Each setting's (measured, kept, median error, wrong) on one view and its second frame."""
+    target, camera = world.target, world.camera
+    lower, upper = target.bounds()
+    frames = (view, stereo_partner(view, baseline))
+    poses = [viewpoint_to_c2w(v, target.center()) for v in frames]
+    images = [grayscale(world.source.render_rgb(v)) for v in frames]
+    exact = world.source.render_depth(view)
+    points = (pixel_rays(camera.K, camera.width, camera.height) * exact[..., None]) @ poses[0][:3, :3].T \
+        + poses[0][:3, 3]
+    inside = (exact > 0) & np.all((points >= lower - 1e-3) & (points <= upper + 1e-3), axis=-1)
+    ranges = [box_depth_range(lower, upper, pose) for pose in poses]
+    near, far = min(r[0] for r in ranges), max(r[1] for r in ranges)
+    scores = {}
+    for name, config in configs.items():
+        depth = two_view_depth(*images, camera.K, *poses, near, far, config)[0]
+        kept = np.isfinite(depth) & inside
+        error = np.abs(depth[kept] - exact[kept]) / exact[kept]
+        scores[name] = (int(inside.sum()), int(kept.sum()), error.tolist())
+    return scores
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scenes", nargs="+", default=list(TRAIN_SCENES[:4]))
+    parser.add_argument("--baselines", type=float, nargs="+", default=[0.15, 0.25, 0.4])
+    parser.add_argument("--views", type=int, default=8, help="random views per building")
+    parser.add_argument("--out", type=Path, required=True)
+    args = parser.parse_args()
+    if any(held_out(s) for s in args.scenes):
+        raise SystemExit("held-out buildings are not for choosing: give training ones")
+    trained = default_preset().env
+    configs = {name: replace(StereoConfig(), **change) for name, change in VARIANTS.items()}
+    totals: dict[tuple[float, str], list] = {(b, n): [0, 0, []] for b in args.baselines for n in configs}
+    for scene in tqdm(args.scenes, desc="buildings", unit="building"):
+        world = PlanningWorld(evaluation_env_config(trained, SceneSet(scene=(scene,))), seed=0)
+        rng = np.random.default_rng(0)
+        for view in [draw_viewpoint(trained.low, trained.high, rng) for _ in range(args.views)]:
+            for baseline in args.baselines:
+                for name, (inside, kept, error) in score_view(world, view, baseline, configs).items():
+                    total = totals[baseline, name]
+                    total[0], total[1] = total[0] + inside, total[1] + kept
+                    total[2].extend(error)
+    rows, records = [], []
+    for (baseline, name), (inside, kept, error) in totals.items():
+        record = {"baseline_m": baseline, "setting": name, "measured": kept / max(inside, 1),
+                  "median_error": float(np.median(error)) if error else None,
+                  "wrong": float(np.mean(np.array(error) > 0.05)) if error else None}
+        records.append(record)
+        rows.append([f"{baseline:g}", name, f"{100 * record['measured']:.1f}",
+                     "-" if not error else f"{100 * record['median_error']:.2f}",
+                     "-" if not error else f"{100 * record['wrong']:.1f}"])
+    table = markdown_table(["baseline (m)", "setting", "measured %", "median error %", "wrong (> 5 %) %"],
+                           rows)
+    with atomic_folder(args.out, overwrite=True, outputs=("results.json", "results.md")) as out:
+        command = portable_record({k: str(v) for k, v in vars(args).items()})
+        write_json(out / "results.json", {"command": command, "commit": git_commit(), "results": records})
+        write_text(out / "results.md", f"# Plane-sweep stereo depth on training buildings\n\n{table}\n")
+    print(table)
+
+
+if __name__ == "__main__":
+    main()

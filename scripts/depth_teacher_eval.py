@@ -6,7 +6,9 @@ that its next views would be the first to see; its students do not follow it (ro
 fused from the depth flown instead of the mesh; this study flies it with several flight weights (coverage
 points of the grid's voxels a metre), grid resolutions and ray strides (every n-th pixel at the default
 preset's 160 x 120) on the validation buildings, scored as `scripts/looks_eval.py` scores every planner;
-round 23 chose `lookahead`'s setting with it.
+round 23 chose `lookahead`'s setting with it. With `--stereo`, each weight is also flown on the depth that
+plane-sweep stereo finds between two frames a view (`lookahead-stereo`, name ending _stereo), and again with
+every frame blank (round 25).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -34,20 +36,28 @@ def main() -> None:
     parser.add_argument("--gain-ray-stride", type=int, default=8, help="every n-th pixel's ray, both axes")
     parser.add_argument("--distinct", action="store_true",
                         help="also fly each weight never stepping onto a view already flown (name ending _d)")
+    parser.add_argument("--stereo", action="store_true",
+                        help="also fly each weight on stereo depth from the images (name ending _stereo)")
     looks_eval.study_arguments(parser)
     args = parser.parse_args()
     looks_eval.refuse_held_out(args.scenes)
     trained = default_preset().env
     rays = max(1, trained.camera.width // args.gain_ray_stride)
     planners = {name: (make_planner(name, PlanSettings()), False) for name in ("orbit", "orbit2", "random")}
-    names = []
+    names, blanks = [], {}
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"
         for distinct in (False, True) if args.distinct else (False,):
             planner = LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays, distinct=distinct)
             planners[name + "_d" * distinct] = (planner, False)
             names.append(name + "_d" * distinct)
-    results = looks_eval.evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work)
+        if args.stereo:
+            stereo = {blank: LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays, depth="stereo",
+                                              blank_images=blank) for blank in (False, True)}
+            planners[name + "_stereo"], blanks[name + "_stereo"] = (stereo[False], False), stereo[True]
+            names.append(name + "_stereo")
+    results = looks_eval.evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work,
+                                  blanks=blanks)
     checks = looks_eval.policy_acceptance(results, args.scenes, names)
     table = looks_eval.report(results, args.scenes, args.seeds, args.views, "orbit", checks)
     with atomic_folder(args.out, overwrite=True, outputs=looks_eval.STUDY_OUTPUTS) as out:

@@ -144,17 +144,20 @@ def summarise(by_scene: dict[str, dict], scenes: list[str], seeds: list[int]) ->
 
 
 def evaluate(planners: dict[str, tuple[Planner, bool]], trained: EnvConfig, scenes: list[str],
-             seeds: list[int], views: int, work: Path, blank_images: bool = True) -> dict:
-    """Every planner's runs and summary (policies also with blank images, unless `blank_images` is off);
-    each (planner, building) kept in `work/NAME/SCENE.json` and reused while its key holds and it has
-    what is asked (so buildings can be scored by processes side by side, then gathered)."""
+             seeds: list[int], views: int, work: Path, blank_images: bool = True,
+             blanks: dict[str, Planner] | None = None) -> dict:
+    """Every planner's runs and summary (policies also with blank images, unless `blank_images` is off, and
+    a planner named in `blanks` with its twin there that is given blank images); each (planner, building)
+    kept in `work/NAME/SCENE.json` and reused while its key holds and it has what is asked (so buildings
+    can be scored by processes side by side, then gathered)."""
     scorer, results = Scorer(trained, views), {}
     for name, (planner, is_policy) in planners.items():
         checkpoint = Path(planner.checkpoint) if is_policy else None
         key = {"seeds": seeds, "views": views, "checkpoint": str(checkpoint),
                "mtime": checkpoint.stat().st_mtime if checkpoint else None}
         env = planner.env_config if is_policy else trained
-        blank = PolicyPlanner(checkpoint, blank_images=True) if is_policy and blank_images else None
+        blank = PolicyPlanner(checkpoint, blank_images=True) if is_policy else (blanks or {}).get(name)
+        blank = blank if blank_images else None
         by_scene = {}
         for scene in scenes:
             saved = work / name / f"{scene.replace(':', '_')}.json"

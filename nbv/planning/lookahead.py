@@ -58,8 +58,8 @@ LOOKAHEAD_FLIGHT = 0.07
 HORIZON, DISCOUNT = 3, 0.9
 """Views scored ahead per candidate step, and the weight a step further (the teacher's defaults)."""
 STEREO_BASELINE_M = 0.25
-"""How far along the orbit `lookahead-stereo` takes each view's second frame, metres (a training building's
-choice, scripts/stereo_depth_eval.py)."""
+"""How far along the orbit `lookahead-stereo` takes each view's second frame, metres (chosen with the sweep's
+settings on four training buildings, paper_results/selection/round25/stereo_depth)."""
 DEPTH_SOURCES = ("camera", "stereo")
 """Where the look-ahead's depth comes from: a depth camera, or plane-sweep stereo on two frames a view."""
 

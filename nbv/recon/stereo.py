@@ -28,13 +28,14 @@ from render.viewpoint import validate_pose
 
 @dataclass(frozen=True)
 class StereoConfig:
-    """Plane-sweep settings, chosen on a training building (`scripts/stereo_depth_eval.py`)."""
+    """Plane-sweep settings, chosen on four training buildings (`scripts/stereo_depth_eval.py`, round 25: the
+    most pixels measured, 67 % of the target's, with at most 5 % of them more than 5 % off)."""
 
     hypotheses: int = 96
     """Depth hypotheses between near and far, evenly spaced in inverse depth."""
-    window: int = 7
+    window: int = 9
     """Side of the square correlation window, pixels (odd)."""
-    min_correlation: float = 0.7
+    min_correlation: float = 0.6
     """Least NCC of the best hypothesis for a pixel to keep its depth."""
     min_texture: float = 0.02
     """Least standard deviation of intensity (0 to 1) in a window, in the reference and the sampled source,

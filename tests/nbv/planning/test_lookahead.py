@@ -9,15 +9,27 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from nbv.flight.path import shell_path
+from nbv.flight.path import azimuth_step, shell_path
 from nbv.planning.config import PlanSettings
-from nbv.planning.lookahead import LOOKAHEAD_FLIGHT, LookaheadPlanner, lookahead_planner, revisits
+from nbv.planning.infogain import target_grid
+from nbv.planning.lookahead import (
+    LOOKAHEAD_FLIGHT,
+    STEREO_BASELINE_M,
+    LookaheadPlanner,
+    lookahead_planner,
+    revisits,
+    stereo_partner,
+)
 from nbv.planning.registry import make_planner
 from nbv.planning.world import PlanningWorld
+from nbv.recon.config import OccupancyConfig
+from nbv.recon.occupancy import UNKNOWN
 from nbv.rl.env import action_to_viewpoint
 from nbv.rl.expert import CANDIDATES
 from nbv.rl.presets import ORBIT_STEP
-from render.viewpoint import Viewpoint
+from render.camera import UAVCamera
+from render.settings import RenderSettings
+from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from tests.nbv.rl.test_bov_observation import config
 
 
@@ -70,3 +82,31 @@ def test_the_spec_sets_the_flight_weight_and_refuses_bad_ones():
         lookahead_planner(PlanSettings(), 0, "fast")
     with pytest.raises(ValueError, match="finite flight weight >= 0"):
         lookahead_planner(PlanSettings(), 0, "-1")
+
+
+def test_the_second_frame_is_the_baseline_back_along_the_orbit():
+    view = Viewpoint(2.0, 0.1, 0.5)
+    partner = stereo_partner(view)
+    centre = np.zeros(3)
+    chord = viewpoint_to_c2w(view, centre)[:3, 3] - viewpoint_to_c2w(partner, centre)[:3, 3]
+    assert np.linalg.norm(chord) == pytest.approx(STEREO_BASELINE_M)
+    assert (partner.radius, partner.elevation) == (view.radius, view.elevation)
+    assert azimuth_step(view.azimuth, partner.azimuth) < 0  # back: clockwise
+
+
+def test_stereo_measures_the_building_and_blank_frames_measure_nothing():
+    world = PlanningWorld(config(camera=UAVCamera(160, 120), render=RenderSettings(spp=4)), seed=3)
+    known = {}
+    for blank in (False, True):
+        planner = LookaheadPlanner(grid=16, rays=8, depth="stereo", blank_images=blank)
+        grid = target_grid(world.target, OccupancyConfig(grid_resolution=16))
+        planner.measure(world, grid, world.start)
+        known[blank] = (grid.state != UNKNOWN).mean()
+    assert known[True] == 0.0 and known[False] > 0.05  # blank frames match nothing: the grid stays unknown
+    small = PlanningWorld(config(), seed=3)
+    views = LookaheadPlanner(grid=16, rays=8, depth="stereo").plan(small, 3)
+    assert views[0] == small.start and len(views) == 3
+    assert make_planner("lookahead-stereo", PlanSettings()).name == "lookahead-stereo"
+    assert make_planner("lookahead-stereo:0.2", PlanSettings(blank_images=True)).blank_images
+    with pytest.raises(ValueError, match="depth from"):
+        LookaheadPlanner(depth="lidar")

@@ -16,8 +16,8 @@ from render.viewpoint import Viewpoint
 from scenes.spec import SceneSpec
 
 ROOT = Path(__file__).resolve().parents[3]
-SHIPPED = ("random", "circle", "orbit", "orbit2", "greedy", "hemisphere", "infogain", "lookahead", "policy",
-           "policy-sample", "policy-paper", "oracle")
+SHIPPED = ("random", "circle", "orbit", "orbit2", "greedy", "hemisphere", "infogain", "lookahead",
+           "lookahead-stereo", "policy", "policy-sample", "policy-paper", "oracle")
 
 
 class ToyPlanner(Planner):

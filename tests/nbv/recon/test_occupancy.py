@@ -43,6 +43,14 @@ def test_no_hit_frees_the_whole_ray_and_a_later_ray_does_not_clear_a_hit():
     assert grid.state[:, 0, 0].tolist() == [FREE, OCCUPIED, OCCUPIED, UNKNOWN]
 
 
+def test_a_pixel_not_measured_carves_and_marks_nothing():
+    grid = row_of_four()
+    grid.integrate(np.array([[np.nan]], np.float32), ONE_PIXEL, ALONG_X)  # stereo found no match
+    assert grid.state[:, 0, 0].tolist() == [UNKNOWN] * 4
+    grid.integrate(np.array([[2.5, np.nan]], np.float32), ONE_PIXEL, ALONG_X)  # the first pixel is the axis
+    assert grid.state[:, 0, 0].tolist() == [FREE, OCCUPIED, UNKNOWN, UNKNOWN]
+
+
 def test_gain_counts_the_unknown_voxels_a_view_reaches_before_an_occupied_one():
     grid = row_of_four()
     assert grid.gain(ONE_PIXEL, ALONG_X, 1, 1) == 4  # all unknown: nothing stops the ray

@@ -1,0 +1,91 @@
+"""Plane-sweep stereo against analytic answers: a textured plane seen by two cameras side by side gives its
+depth where both see it; a step in depth keeps both levels and (all but a few pixels of) the strip one view
+cannot see is left unmeasured; blank images measure nothing; bad settings are refused by their messages."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from nbv.recon.stereo import StereoConfig, box_depth_range, grayscale, sweep, two_view_depth
+from render.camera import UAVCamera, pixel_rays
+
+CAMERA = UAVCamera(160, 120)
+BASELINE = 0.25
+
+
+def texture(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """A smooth, non-repeating pattern on the plane (sum of 24 seeded sinusoids, wavelengths 4 to 30 cm)."""
+    rng = np.random.default_rng(7)
+    value = np.zeros_like(x)
+    for _ in range(24):
+        angle, wavelength, phase = rng.uniform(0, np.pi), rng.uniform(0.04, 0.3), rng.uniform(0, 2 * np.pi)
+        value += np.sin(2 * np.pi * (x * np.cos(angle) + y * np.sin(angle)) / wavelength + phase)
+    return 0.5 + value / 12.0
+
+
+def pose(x: float) -> np.ndarray:
+    """A camera at (x, 0, 0) looking along +z (OpenCV axes are the world's)."""
+    c2w = np.eye(4)
+    c2w[0, 3] = x
+    return c2w
+
+
+def image(surfaces: list[tuple[float, float]], camera_x: float) -> tuple[np.ndarray, np.ndarray]:
+    """What a camera at `camera_x` sees of textured fronto-parallel planes (depth z, from world x on to +inf),
+    and its z-depth: the nearest plane a ray meets (exact: planes parallel to the image)."""
+    rays = pixel_rays(CAMERA.K, CAMERA.width, CAMERA.height)
+    best, shade = np.full(rays.shape[:2], np.inf), np.zeros(rays.shape[:2])
+    for z, start in surfaces:
+        x, y = camera_x + rays[..., 0] * z, rays[..., 1] * z
+        hit = (x >= start) & (z < best)
+        best[hit], shade[hit] = z, texture(x, y)[hit]
+    return shade, best
+
+
+def test_a_textured_plane_gives_its_depth_where_both_views_see_it():
+    plane = [(2.0, -np.inf)]
+    (left, truth), (right, _) = image(plane, 0.0), image(plane, BASELINE)
+    depth, other = two_view_depth(left, right, CAMERA.K, pose(0.0), pose(BASELINE), 1.0, 4.0)
+    error, kept = np.abs(depth - truth) / truth, np.isfinite(depth)
+    shift = CAMERA.K[0, 0] * BASELINE / 2.0  # the disparity, 19.4 pixels
+    assert not kept[:, :int(shift)].any()  # the left strip is off the other image: not measured
+    assert kept[:, int(shift) + 4:].mean() > 0.95
+    assert np.nanquantile(error, 0.99) < 0.005 and np.nanmax(error) < 0.03
+    assert np.nanmax(np.abs(other - 2.0)) < 0.06 and not np.isfinite(other[:, -int(shift):]).any()
+
+
+def test_a_step_keeps_both_levels_and_not_the_strip_one_view_cannot_see():
+    step = [(2.5, -np.inf), (1.5, 0.3)]  # a near plane on the right, its edge at x = 0.3, before a far one
+    (left, truth), (right, _) = image(step, 0.0), image(step, BASELINE)
+    depth, _ = two_view_depth(left, right, CAMERA.K, pose(0.0), pose(BASELINE), 1.0, 4.0)
+    kept, wrong = np.isfinite(depth), np.abs(depth - truth) / truth > 0.02
+    edge = int(np.argmax(truth[0] == 1.5))  # the first near column
+    columns = np.arange(CAMERA.width)
+    assert (kept & wrong).sum() < 0.01 * kept.sum()  # a few wrong: near the edge and what it hides
+    assert not (kept & wrong)[:, (columns < edge - 16) | (columns > edge + 4)].any()
+    for level in (1.5, 2.5):
+        assert (kept & (truth == level)).sum() > 0.8 * ((truth == level) & (columns >= 24)).sum() - 12 * 120
+    # far points at x in (1/3, 1/2) are seen by the left camera and hidden from the right one by the edge
+    far_x = pixel_rays(CAMERA.K, CAMERA.width, CAMERA.height)[..., 0] * 2.5
+    hidden = (truth == 2.5) & (far_x > 1 / 3 + 0.01) & (far_x < 0.49)
+    assert hidden.sum() > 8 * 120 and kept[hidden].mean() < 0.05
+
+
+def test_blank_images_measure_nothing():
+    blank = np.zeros((CAMERA.height, CAMERA.width))
+    depth, other = two_view_depth(blank, blank, CAMERA.K, pose(0.0), pose(BASELINE), 1.0, 4.0)
+    assert np.isnan(depth).all() and np.isnan(other).all()
+    best, correlation = sweep(blank, blank, CAMERA.K, pose(0.0), pose(BASELINE), 1.0, 4.0)
+    assert np.isnan(best).all() and (correlation == -1).all()
+
+
+def test_box_range_grayscale_and_refusals():
+    near, far = box_depth_range(np.array([-1.0, -1, 2]), np.array([1.0, 1, 3]), pose(0.0))
+    assert (near, far) == (2.0, 3.0)
+    assert box_depth_range(np.array([-1.0, -1, -3]), np.array([1.0, 1, 3]), pose(0.0))[0] == 0.05
+    assert grayscale(np.full((1, 1, 3), 255, np.uint8))[0, 0] == pytest.approx(1.0)
+    with pytest.raises(ValueError, match="odd window"):
+        StereoConfig(window=6)
+    with pytest.raises(ValueError, match="0 < near < far"):
+        sweep(np.zeros((4, 4)), np.zeros((4, 4)), CAMERA.K, pose(0.0), pose(BASELINE), 2.0, 1.0)

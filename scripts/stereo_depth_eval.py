@@ -11,6 +11,9 @@ holds):
 - median error: of the kept depths, relative to the exact one;
 - wrong: the share of kept depths more than 5 % off (they mark the wrong voxel occupied).
 
+`stereo.png` shows the first building's first view at the first baseline: its frame, the exact depth, the
+chosen setting's stereo depth and its error.
+
 The rule, set before the run: the setting and baseline that measure the most pixels with at most 5 % of
 them wrong.
 
@@ -24,15 +27,17 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+from matplotlib.figure import Figure
 from tqdm import tqdm
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import git_commit, portable_record
-from nbv.planning.lookahead import stereo_partner
+from nbv.planning.lookahead import STEREO_BASELINE_M, stereo_partner
 from nbv.planning.world import PlanningWorld
 from nbv.recon.stereo import StereoConfig, box_depth_range, grayscale, two_view_depth
 from nbv.rl.presets import TRAIN_SCENES, default_preset
 from nbv.rl.validate import evaluation_env_config
+from nbv.viz.figures import save_figure
 from render.camera import pixel_rays
 from render.viewpoint import draw_viewpoint, viewpoint_to_c2w
 from scenes.family_splits import held_out
@@ -48,8 +53,10 @@ VARIANTS = {"round 25's start": {"window": 7, "min_correlation": 0.7}, "window 9
 least correlation of 0.7, and chose the last)."""
 
 
-def score_view(world: PlanningWorld, view, baseline: float, configs: dict[str, StereoConfig]) -> dict:
-    """Each setting's (measured, kept, median error, wrong) on one view and its second frame."""
+def score_view(world: PlanningWorld, view, baseline: float, configs: dict[str, StereoConfig],
+               figure: Path | None = None) -> dict:
+    """Each setting's (target pixels, kept, errors) on one view and its second frame; with `figure`, the
+    view's picture of the default setting written there."""
     target, camera = world.target, world.camera
     lower, upper = target.bounds()
     frames = (view, stereo_partner(view, baseline))
@@ -67,7 +74,52 @@ def score_view(world: PlanningWorld, view, baseline: float, configs: dict[str, S
         kept = np.isfinite(depth) & inside
         error = np.abs(depth[kept] - exact[kept]) / exact[kept]
         scores[name] = (int(inside.sum()), int(kept.sum()), error.tolist())
+        if figure is not None and config == StereoConfig():
+            depth_figure(images[0], exact, depth, inside, figure)
     return scores
+
+
+def depth_figure(image: np.ndarray, exact: np.ndarray, stereo: np.ndarray, inside: np.ndarray,
+                 out: Path) -> Path:
+    """The frame, its exact depth, the stereo depth (blank where not measured) and the relative error."""
+    fig = Figure(figsize=(12, 2.9))
+    shown = np.where(exact > 0, exact, np.nan)
+    low, high = np.nanmin(shown), np.nanmax(shown)
+    error = np.abs(stereo - exact) / np.where(exact > 0, exact, np.nan)
+    panels = [(image, "frame", "gray", (0, 1)), (shown, "exact depth (m)", "viridis", (low, high)),
+              (stereo, f"stereo depth: {100 * np.isfinite(stereo[inside]).mean():.0f} % of the target",
+               "viridis", (low, high)), (error, "relative error (0 to 10 %)", "magma", (0, 0.1))]
+    for index, (data, title, cmap, (vmin, vmax)) in enumerate(panels):
+        ax = fig.add_subplot(1, 4, index + 1)
+        shown_image = ax.imshow(data, cmap=cmap, vmin=vmin, vmax=vmax)
+        ax.set_title(title, fontsize=9)
+        ax.set_axis_off()
+        if index:
+            fig.colorbar(shown_image, ax=ax, fraction=0.035)
+    return save_figure(fig, out)
+
+
+def measure(scenes: list[str], baselines: list[float], views: int, configs: dict[str, StereoConfig],
+            figure: Path) -> dict[tuple[float, str], list]:
+    """Per (baseline, setting): target pixels, kept pixels and the kept depths' relative errors, summed over
+    `views` random views of each building (the picture of the first building's first view at the shipped
+    baseline, or the first, written to `figure`)."""
+    trained = default_preset().env
+    shown = STEREO_BASELINE_M if STEREO_BASELINE_M in baselines else baselines[0]
+    totals: dict[tuple[float, str], list] = {(b, n): [0, 0, []] for b in baselines for n in configs}
+    for scene in tqdm(scenes, desc="buildings", unit="building"):
+        world = PlanningWorld(evaluation_env_config(trained, SceneSet(scene=(scene,))), seed=0)
+        rng = np.random.default_rng(0)
+        drawn = [draw_viewpoint(trained.low, trained.high, rng) for _ in range(views)]
+        for view in drawn:
+            for baseline in baselines:
+                first = scene == scenes[0] and view == drawn[0] and baseline == shown
+                for name, (inside, kept, error) in score_view(world, view, baseline, configs,
+                                                              figure if first else None).items():
+                    total = totals[baseline, name]
+                    total[0], total[1] = total[0] + inside, total[1] + kept
+                    total[2].extend(error)
+    return totals
 
 
 def main() -> None:
@@ -79,33 +131,24 @@ def main() -> None:
     args = parser.parse_args()
     if any(held_out(s) for s in args.scenes):
         raise SystemExit("held-out buildings are not for choosing: give training ones")
-    trained = default_preset().env
     configs = {name: replace(StereoConfig(), **change) for name, change in VARIANTS.items()}
-    totals: dict[tuple[float, str], list] = {(b, n): [0, 0, []] for b in args.baselines for n in configs}
-    for scene in tqdm(args.scenes, desc="buildings", unit="building"):
-        world = PlanningWorld(evaluation_env_config(trained, SceneSet(scene=(scene,))), seed=0)
-        rng = np.random.default_rng(0)
-        for view in [draw_viewpoint(trained.low, trained.high, rng) for _ in range(args.views)]:
-            for baseline in args.baselines:
-                for name, (inside, kept, error) in score_view(world, view, baseline, configs).items():
-                    total = totals[baseline, name]
-                    total[0], total[1] = total[0] + inside, total[1] + kept
-                    total[2].extend(error)
-    rows, records = [], []
-    for (baseline, name), (inside, kept, error) in totals.items():
-        record = {"baseline_m": baseline, "setting": name, "measured": kept / max(inside, 1),
-                  "median_error": float(np.median(error)) if error else None,
-                  "wrong": float(np.mean(np.array(error) > 0.05)) if error else None}
-        records.append(record)
-        rows.append([f"{baseline:g}", name, f"{100 * record['measured']:.1f}",
-                     "-" if not error else f"{100 * record['median_error']:.2f}",
-                     "-" if not error else f"{100 * record['wrong']:.1f}"])
-    table = markdown_table(["baseline (m)", "setting", "measured %", "median error %", "wrong (> 5 %) %"],
-                           rows)
-    with atomic_folder(args.out, overwrite=True, outputs=("results.json", "results.md")) as out:
+    with atomic_folder(args.out, overwrite=True, outputs=("results.json", "results.md", "stereo.png")) as out:
+        totals = measure(args.scenes, args.baselines, args.views, configs, out / "stereo.png")
+        rows, records = [], []
+        for (baseline, name), (inside, kept, error) in totals.items():
+            record = {"baseline_m": baseline, "setting": name, "measured": kept / max(inside, 1),
+                      "median_error": float(np.median(error)) if error else None,
+                      "wrong": float(np.mean(np.array(error) > 0.05)) if error else None}
+            records.append(record)
+            rows.append([f"{baseline:g}", name, f"{100 * record['measured']:.1f}",
+                         "-" if not error else f"{100 * record['median_error']:.2f}",
+                         "-" if not error else f"{100 * record['wrong']:.1f}"])
+        table = markdown_table(["baseline (m)", "setting", "measured %", "median error %", "wrong (> 5 %) %"],
+                               rows)
         command = portable_record({k: str(v) for k, v in vars(args).items()})
         write_json(out / "results.json", {"command": command, "commit": git_commit(), "results": records})
-        write_text(out / "results.md", f"# Plane-sweep stereo depth on training buildings\n\n{table}\n")
+        write_text(out / "results.md", f"# Plane-sweep stereo depth on training buildings\n\n{table}\n\n"
+                   "![one view](stereo.png)\n")
     print(table)
 
 

@@ -95,3 +95,22 @@ def test_an_env_planner_flies_its_actions_from_the_plans_start_and_refuses_anoth
     assert len(Walker(0.0).plan(world, None)) == 13
     with pytest.raises(RuntimeError, match="walker starts at .* the plan at"):
         Walker(1.0).plan(world, 3)
+
+
+def test_a_planner_named_in_blanks_is_flown_again_by_its_blank_twin(monkeypatch, tmp_path):
+    flown = []
+
+    def score(scorer, planner, env, scene, seeds, blank):
+        flown.append((planner, blank))
+        return building([95.0], 12.0, 2.0, blank=[80.0] if blank else None)
+
+    monkeypatch.setattr(module, "score_scene", score)
+    seeing, twin, blind = object(), object(), object()
+    planners = {"seeing": (seeing, False), "blind": (blind, False)}
+    found = module.evaluate(planners, None, ["a"], [0], 13, tmp_path / "work", blanks={"seeing": twin})
+    assert flown == [(seeing, twin), (blind, None)]
+    assert found["seeing"]["runs"]["a"]["blank"] == {"0": 80.0} and found["blind"]["runs"]["a"]["blank"] == {}
+    flown.clear()
+    module.evaluate(planners, None, ["a"], [0], 13, tmp_path / "again", blank_images=False,
+                    blanks={"seeing": twin})
+    assert flown == [(seeing, None), (blind, None)]

@@ -38,6 +38,8 @@ def main() -> None:
                         help="also fly each weight never stepping onto a view already flown (name ending _d)")
     parser.add_argument("--stereo", action="store_true",
                         help="also fly each weight on stereo depth from the images (name ending _stereo)")
+    parser.add_argument("--no-camera", action="store_true",
+                        help="with --stereo, fly only the stereo look-ahead (not the depth camera's)")
     looks_eval.study_arguments(parser)
     args = parser.parse_args()
     looks_eval.refuse_held_out(args.scenes)
@@ -47,7 +49,7 @@ def main() -> None:
     names, blanks = [], {}
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"
-        for distinct in (False, True) if args.distinct else (False,):
+        for distinct in () if args.no_camera else (False, True) if args.distinct else (False,):
             planner = LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays, distinct=distinct)
             planners[name + "_d" * distinct] = (planner, False)
             names.append(name + "_d" * distinct)

@@ -41,7 +41,7 @@ from nbv.experiments.planner_study import PlannerStudy, run_study
 from nbv.experiments.sfm_columns import SFM_HEADER, sfm_cells, sfm_entry
 from nbv.experiments.study import FullScanStudy
 from nbv.planning.config import PlanSettings
-from nbv.planning.registry import depth_planners, tuned_planners
+from nbv.planning.registry import depth_planners, image_planners, tuned_planners
 from nbv.recon.heatmap import write_heatmap
 from nbv.recon.metrics import SurfaceMetrics, evaluate_surfaces
 from nbv.recon.tsdf import Reconstruction, reconstruct_dataset, save_reconstruction
@@ -54,7 +54,8 @@ from scenes.model import Scene
 OUTPUTS = ("refined", "recon_full", "recon_refined", "contact_sheet.png", "trajectory_full.png",
            "trajectory_refined.png", "heatmap_refined_vs_full.png", "heatmap_refined_vs_full.ply",
            "heatmap_full_vs_gt.png", "heatmap_full_vs_gt.ply", "results.json", "results.md", "online_policy",
-           "online_random", *(f"online_{name}" for name in (*tuned_planners(), *depth_planners())),
+           "online_random",
+           *(f"online_{name}" for name in (*tuned_planners(), *depth_planners(), *image_planners())),
            "sfm_full", "sfm_refined", "refined_linked", "sfm_refined_linked")
 """What one demo run writes into `--out`, all together (the cached `full_scan/` beside them is kept)."""
 
@@ -197,11 +198,12 @@ def online_study(config: DemoConfig, folder: Path, name: str, planner: str,
 
 def online_half(config: DemoConfig, folder: Path) -> dict[str, dict[str, Any]]:
     """The policy's one pass around `online_scene`, then random views, the registry's tuned orbits
-    (`tuned_planners`) and depth options (`depth_planners`) at its count: `nbv plan` runs."""
+    (`tuned_planners`), depth options (`depth_planners`) and image-only look-ahead (`image_planners`) at its
+    count: `nbv plan` runs."""
     policy = run_study(online_study(config, folder, "policy", config.policy, None))[0].plan()
     keep = ("views", "planning_s", "gt", "flight_m", "azimuth_reversals", *(("sfm",) if config.sfm else ()))
     runs = {"policy": policy}
-    for name in ("random", *tuned_planners(), *depth_planners()):
+    for name in ("random", *tuned_planners(), *depth_planners(), *image_planners()):
         runs[name] = run_study(online_study(config, folder, name, name, policy["views"]))[0].plan()
     return {name: {k: plan[k] for k in keep} for name, plan in runs.items()}
 

@@ -47,7 +47,14 @@ from nbv.experiments.planner_study import run_studies, scene_folder
 from nbv.experiments.sfm_columns import sfm_table
 from nbv.fanout.config import ExecutorConfig
 from nbv.planning.config import PlanSettings
-from nbv.planning.registry import SHIPPED_POLICIES, compared_planners, depth_planners, entry, planner_label
+from nbv.planning.registry import (
+    SHIPPED_POLICIES,
+    compared_planners,
+    depth_planners,
+    entry,
+    image_planners,
+    planner_label,
+)
 from nbv.recon.config import MetricsConfig
 from nbv.sfm.config import SfmOption
 from nbv.viz.figures import plot_seed_scores
@@ -70,10 +77,11 @@ class OnlineConfig(SfmOption):
     """Folder of the per-building comparisons and of online.{md,json,png}."""
     scenes: tuple[str, ...] = HELD_OUT
     """Buildings to plan for (held out from training)."""
-    policies: tuple[str, ...] = SHIPPED_POLICIES
+    policies: tuple[str, ...] = (*SHIPPED_POLICIES, *image_planners())
     """Policies to evaluate on their mode (policy: the shipped default; policy-paper: the paper preset's, so
-    the paper's method stands beside ours; policy:CHECKPOINT for others); the first is the one the margins
-    describe. Each flies the one-pass protocol too."""
+    the paper's method stands beside ours; policy:CHECKPOINT for others), and planners that read only images
+    and poses (the registry's: `lookahead-stereo`); the first is the one the margins describe. Each
+    learnt policy flies the one-pass protocol too."""
     depth_options: tuple[str, ...] = field(default_factory=depth_planners)
     """Issue 26's named depth options (the registry's: `lookahead`), flown at the fixed budget and held to the
     policies' checks in columns of their own, reported apart from the policies (which read only images and
@@ -112,8 +120,9 @@ def comparisons(config: OnlineConfig) -> list[CompareConfig]:
         folder = Path(config.out) / scene_folder(scene)
         found.append(CompareConfig(**common, views=config.views, out=folder / f"views{config.views}",
                                    planners=(*config.policies, *config.depth_options, *config.baselines)))
-        if config.one_pass:
-            found.append(CompareConfig(**common, planners=config.policies, out=folder / "onepass"))
+        learnt = tuple(p for p in config.policies if not entry(p).image_option)  # the ones with a stop rule
+        if config.one_pass and learnt:
+            found.append(CompareConfig(**common, planners=learnt, out=folder / "onepass"))
         seeing = tuple(p for p in config.policies if "blank_images" in entry(p).settings)
         if config.blank and seeing:
             blank = replace(config.settings, blank_images=True)

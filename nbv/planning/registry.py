@@ -67,6 +67,10 @@ class PlannerEntry:
     """Issue 26's named depth option: a planner that looks at the depth it measures (the policies read only
     images and poses). `nbv online` holds it to the policies' checks in a column of its own, and the demo
     flies it beside them."""
+    image_option: bool = False
+    """A planner with a rule of its own (not learnt) that reads only images and the poses flown, as the
+    policies do (`lookahead-stereo`): `nbv online` reports it with the policies, held to every check, and
+    the demo flies it beside them."""
 
     @property
     def spec(self) -> str:
@@ -109,7 +113,7 @@ PLANNERS: tuple[PlannerEntry, ...] = (
                  "from plane-sweep stereo depth of each view and a second frame 0.25 m along its orbit "
                  "(reads images and poses, as the policies do; lookahead-stereo:W another weight)",
                  "nbv.planning.lookahead:stereo_lookahead_planner", settings=("blank_images",), argument="W",
-                 budget=False),
+                 budget=False, image_option=True),
     PlannerEntry("policy", "a trained actor (a `nbv train` checkpoint.pt or policy.pt; none: the shipped "
                  "policy) from the start view, acting on its distribution's mode",
                  "nbv.planning.policy:policy_planner", settings=("blank_images",), checkpoint=True),
@@ -233,6 +237,12 @@ def depth_planners() -> tuple[str, ...]:
     """The named depth options (`nbv online --depth-options`, the demo's online half): every entry with
     `depth_option` set."""
     return tuple(e.name for e in entries() if e.depth_option)
+
+
+def image_planners() -> tuple[str, ...]:
+    """The image-only planners with rules of their own (`nbv online`'s policies after the shipped ones, the
+    demo's online half): every entry with `image_option` set."""
+    return tuple(e.name for e in entries() if e.image_option)
 
 
 def replanned() -> tuple[str, ...]:

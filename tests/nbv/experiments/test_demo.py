@@ -63,6 +63,7 @@ def test_demo_runs_every_stage_and_reuses_its_scan(tmp_path, capsys):
     assert 2 <= online["policy"]["views"] <= 4 and online["random"]["views"] == online["policy"]["views"]
     assert online["orbit"]["views"] == online["orbit2"]["views"] == online["policy"]["views"]  # tuned orbits
     assert online["lookahead"]["views"] == online["policy"]["views"]  # the depth option
+    assert online["lookahead-stereo"]["views"] == online["policy"]["views"]  # the image-only look-ahead
     assert 0 < online["policy"]["gt"]["coverage"] <= 1
     assert online["policy"]["flight_m"] > 0 and "| flight (m) | azimuth reversals |" in printed
     assert (tmp_path / "online_policy" / "trajectory.png").is_file()

@@ -105,17 +105,20 @@ def test_online_hands_every_run_of_every_building_to_the_executor_at_once(tmp_pa
     stages = [comparison_tasks(comparison) for comparison in comparisons(config)]
     references = unique_tasks([task for refs, _ in stages for task in refs])
     runs = unique_tasks([task for _, plans in stages for task in plans])
-    # one reference per building (both protocols share it); the two policies (the default's, the paper's)
-    # the depth option (lookahead) and the registry's 5 compared baselines (random, circle, orbit, orbit2,
-    # greedy) x 2 seeds at 13 views, + each policy's one pass + each policy's 13 views with blank images
+    # one reference per building (both protocols share it); the two policies (the default's, the paper's),
+    # the image-only look-ahead (lookahead-stereo), the depth option (lookahead) and the registry's 5
+    # compared baselines (random, circle, orbit, orbit2, greedy) x 2 seeds at 13 views, + each learnt
+    # policy's one pass (the look-ahead has no stop rule) + the three image readers' 13 views, images blank
     assert config.baselines == ("random", "circle", "orbit", "orbit2", "greedy")
     assert config.depth_options == ("lookahead",)
     assert [task.name for task in references] == ["full-scan reference of alpine_chalet",
                                                   "full-scan reference of random:5"]
-    assert config.policies == ("policy", "policy-paper")
-    assert len(runs) == 2 * (8 * 2 + 2 * 2 + 2 * 2)
-    assert runs[-1].name == f"policy-paper-seed1 in {tmp_path}/random_5/views13-blank"
-    assert runs[-1].result == tmp_path / "random_5" / "views13-blank" / "policy-paper-seed1" / "plan.json"
+    assert config.policies == ("policy", "policy-paper", "lookahead-stereo")
+    assert len(runs) == 2 * (9 * 2 + 2 * 2 + 3 * 2)
+    assert runs[-1].name == f"lookahead-stereo-seed1 in {tmp_path}/random_5/views13-blank"
+    assert runs[-1].result == tmp_path / "random_5" / "views13-blank" / "lookahead-stereo-seed1" / "plan.json"
+    one_pass = [c for c in comparisons(config) if c.views is None]
+    assert [c.planners for c in one_pass] == [("policy", "policy-paper")] * 2
     blank = [c for c in comparisons(config) if c.settings.blank_images]
     assert [c.planners for c in blank] == [config.policies] * 2 and all(c.views == 13 for c in blank)
     assert len(comparisons(OnlineConfig(out=tmp_path, scenes=("random:5",), blank=False))) == 2

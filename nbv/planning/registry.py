@@ -111,7 +111,8 @@ PLANNERS: tuple[PlannerEntry, ...] = (
                  depth_option=True),
     PlannerEntry("lookahead-stereo", "the same look-ahead on what a camera alone measures: the grid fused "
                  "from plane-sweep stereo depth of each view and a second frame 0.25 m along its orbit "
-                 "(reads images and poses, as the policies do; lookahead-stereo:W another weight)",
+                 "(reads images and poses, as the policies do), less 0.1 a metre (lookahead-stereo:W another "
+                 "weight)",
                  "nbv.planning.lookahead:stereo_lookahead_planner", settings=("blank_images",), argument="W",
                  budget=False, image_option=True),
     PlannerEntry("policy", "a trained actor (a `nbv train` checkpoint.pt or policy.pt; none: the shipped "

@@ -15,6 +15,7 @@ from nbv.planning.infogain import target_grid
 from nbv.planning.lookahead import (
     LOOKAHEAD_FLIGHT,
     STEREO_BASELINE_M,
+    STEREO_FLIGHT,
     LookaheadPlanner,
     lookahead_planner,
     revisits,
@@ -106,7 +107,8 @@ def test_stereo_measures_the_building_and_blank_frames_measure_nothing():
     small = PlanningWorld(config(), seed=3)
     views = LookaheadPlanner(grid=16, rays=8, depth="stereo").plan(small, 3)
     assert views[0] == small.start and len(views) == 3
-    assert make_planner("lookahead-stereo", PlanSettings()).name == "lookahead-stereo"
+    stereo = make_planner("lookahead-stereo", PlanSettings())
+    assert (stereo.name, stereo.flight, stereo.depth) == ("lookahead-stereo", STEREO_FLIGHT, "stereo")
     assert make_planner("lookahead-stereo:0.2", PlanSettings(blank_images=True)).blank_images
     with pytest.raises(ValueError, match="depth from"):
         LookaheadPlanner(depth="lidar")

@@ -290,6 +290,9 @@ INDEX = (
            "check: the shipped policies and the depth option (lookahead) against random views and the tuned "
            "orbits, with blank images, on eight held-out buildings (three of the trait family)",
            "nbv online (command in the file)"),
+    Result("online/stereo/online.md", "online/stereo/online.json", "issue 26's acceptance for the "
+           "image-only look-ahead (lookahead-stereo), with blank images, against random views and the tuned "
+           "orbits on the same eight held-out buildings", "nbv online (command in the file)"),
     Result("ablations/README.md", "ablations/ablations.json", "rendering-quality ablations, one axis at a "
            "time", "make ablations"),
     Result("planners/README.md", "planners/comparison.json", "early planner comparison on the held-out "
@@ -346,6 +349,10 @@ INDEX = (
            "teacher's steps", LOOKS_EVAL),
     Result("selection/round24/README.md", "selection/round24/lookahead_distinct/results.json", "its "
            "twenty-fourth round: the depth option's look-ahead never repeating a view (not adopted)",
+           LOOKS_EVAL),
+    Result("selection/round25/README.md", "selection/round25/lookahead_stereo/results.json", "its "
+           "twenty-fifth round: the look-ahead on plane-sweep stereo from the images (lookahead-stereo), its "
+           "stereo setting chosen on training buildings and its flight weight on validation ones",
            LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",

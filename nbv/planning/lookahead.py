@@ -25,6 +25,8 @@ second frame `STEREO_BASELINE_M` along its orbit (a step sideways, as a frame of
 plane-sweep stereo between the two (`nbv.recon.stereo`) gives both frames' depth where it finds a
 consistent match; only that depth is fused, the rest stays unknown. It reads images and the poses flown
 (and the target's box), so it is held to every check of the policies, the blank-images one included.
+Held out, scored once (paper_results/online/stereo): 3.8 points above the ring in 1.26x its metres, 31.3
+lost with blank frames, 3.4 under the ring on the walled compound.
 """
 
 from __future__ import annotations

@@ -67,12 +67,15 @@ def box_depth_range(lower: np.ndarray, upper: np.ndarray, c2w: np.ndarray) -> tu
     return max(float(z.min()), 0.05), max(float(z.max()), 0.1)
 
 
+def _window_mean(x: torch.Tensor, window: int) -> torch.Tensor:
+    """Mean of (N, H, W) images over square windows (the window shrinks at the border)."""
+    return F.avg_pool2d(x[:, None], window, 1, window // 2, count_include_pad=False)[:, 0]
+
+
 def _window_stats(x: torch.Tensor, window: int) -> tuple[torch.Tensor, torch.Tensor]:
-    """Mean and variance of (N, H, W) images over square windows (the window shrinks at the border)."""
-    def pool(t: torch.Tensor) -> torch.Tensor:
-        return F.avg_pool2d(t[:, None], window, 1, window // 2, count_include_pad=False)[:, 0]
-    mean = pool(x)
-    return mean, (pool(x * x) - mean * mean).clamp(min=0.0)
+    """Mean and variance of (N, H, W) images over square windows."""
+    mean = _window_mean(x, window)
+    return mean, (_window_mean(x * x, window) - mean * mean).clamp(min=0.0)
 
 
 def _project(depth: torch.Tensor, K: np.ndarray, ref_c2w: np.ndarray,  # noqa: N803
@@ -111,8 +114,7 @@ def sweep(ref: np.ndarray, src: np.ndarray, K: np.ndarray, ref_c2w: np.ndarray, 
     warped = _sample(source, uv)
     ref_mean, ref_var = _window_stats(reference[None], config.window)
     src_mean, src_var = _window_stats(warped, config.window)
-    cross = F.avg_pool2d((reference[None] * warped)[:, None], config.window, 1, config.window // 2,
-                         count_include_pad=False)[:, 0] - ref_mean * src_mean
+    cross = _window_mean(reference[None] * warped, config.window) - ref_mean * src_mean
     ncc = cross / torch.sqrt((ref_var * src_var).clamp(min=1e-12))
     inside = (z > 0) & (uv[..., 0] >= 0) & (uv[..., 0] <= width - 1) & (uv[..., 1] >= 0) & \
         (uv[..., 1] <= height - 1)

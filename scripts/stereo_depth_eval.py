@@ -18,6 +18,10 @@ The rule, set before the run: the setting and baseline that measure the most pix
 them wrong.
 
     python scripts/stereo_depth_eval.py --baselines 0.15 0.25 0.4 --out OUT
+
+With `--partners`, each view is also swept with second frames on other sides (`back,up`: one back along
+the orbit, one up the meridian, each swept with the view; a pixel counts as measured if any pair measures
+it, and every pair's kept depths count towards the errors, as the grid fuses each).
 """
 
 from __future__ import annotations
@@ -32,7 +36,7 @@ from tqdm import tqdm
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import git_commit, portable_record
-from nbv.planning.lookahead import STEREO_BASELINE_M, stereo_partner
+from nbv.planning.lookahead import PARTNER_SIDES, STEREO_BASELINE_M, stereo_partner
 from nbv.planning.world import PlanningWorld
 from nbv.recon.stereo import StereoConfig, box_depth_range, grayscale, two_view_depth
 from nbv.rl.presets import TRAIN_SCENES, default_preset
@@ -54,28 +58,33 @@ least correlation of 0.7, and chose the last)."""
 
 
 def score_view(world: PlanningWorld, view, baseline: float, configs: dict[str, StereoConfig],
-               figure: Path | None = None) -> dict:
-    """Each setting's (target pixels, kept, errors) on one view and its second frame; with `figure`, the
-    view's picture of the default setting written there."""
+               figure: Path | None = None, sides: tuple[str, ...] = ("back",)) -> dict:
+    """Each setting's (target pixels, kept, errors) on one view swept with its second frame on each of
+    `sides` (kept: measured by any pair; errors: every pair's kept depths, as the grid fuses each); with
+    `figure`, the view's picture of the default setting written there."""
     target, camera = world.target, world.camera
     lower, upper = target.bounds()
-    frames = (view, stereo_partner(view, baseline))
-    poses = [viewpoint_to_c2w(v, target.center()) for v in frames]
-    images = [grayscale(world.source.render_rgb(v)) for v in frames]
+    pose = viewpoint_to_c2w(view, target.center())
+    image = grayscale(world.source.render_rgb(view))
+    others = [viewpoint_to_c2w(stereo_partner(view, baseline, side), target.center()) for side in sides]
+    partners = [grayscale(world.source.render_rgb(stereo_partner(view, baseline, side))) for side in sides]
     exact = world.source.render_depth(view)
-    points = (pixel_rays(camera.K, camera.width, camera.height) * exact[..., None]) @ poses[0][:3, :3].T \
-        + poses[0][:3, 3]
+    rays = pixel_rays(camera.K, camera.width, camera.height)
+    points = (rays * exact[..., None]) @ pose[:3, :3].T + pose[:3, 3]
     inside = (exact > 0) & np.all((points >= lower - 1e-3) & (points <= upper + 1e-3), axis=-1)
-    ranges = [box_depth_range(lower, upper, pose) for pose in poses]
-    near, far = min(r[0] for r in ranges), max(r[1] for r in ranges)
     scores = {}
     for name, config in configs.items():
-        depth = two_view_depth(*images, camera.K, *poses, near, far, config)[0]
-        kept = np.isfinite(depth) & inside
-        error = np.abs(depth[kept] - exact[kept]) / exact[kept]
-        scores[name] = (int(inside.sum()), int(kept.sum()), error.tolist())
+        kept, errors, depth = np.zeros_like(inside), [], None
+        for other, partner in zip(others, partners, strict=True):
+            ranges = [box_depth_range(lower, upper, p) for p in (pose, other)]
+            near, far = min(r[0] for r in ranges), max(r[1] for r in ranges)
+            depth = two_view_depth(image, partner, camera.K, pose, other, near, far, config)[0]
+            pair = np.isfinite(depth) & inside
+            kept |= pair
+            errors.extend((np.abs(depth[pair] - exact[pair]) / exact[pair]).tolist())
+        scores[name] = (int(inside.sum()), int(kept.sum()), errors)
         if figure is not None and config == StereoConfig():
-            depth_figure(images[0], exact, depth, inside, figure)
+            depth_figure(image, exact, depth, inside, figure)
     return scores
 
 
@@ -100,25 +109,27 @@ def depth_figure(image: np.ndarray, exact: np.ndarray, stereo: np.ndarray, insid
 
 
 def measure(scenes: list[str], baselines: list[float], views: int, configs: dict[str, StereoConfig],
-            figure: Path) -> dict[tuple[float, str], list]:
-    """Per (baseline, setting): target pixels, kept pixels and the kept depths' relative errors, summed over
-    `views` random views of each building (the picture of the first building's first view at the shipped
-    baseline, or the first, written to `figure`)."""
+            figure: Path, partners: list[tuple[str, ...]]) -> dict[tuple[str, float, str], list]:
+    """Per (partner sides, baseline, setting): target pixels, kept pixels and the kept depths' relative
+    errors, summed over `views` random views of each building (the picture of the first building's first
+    view at the shipped baseline, or the first, with the first partners, written to `figure`)."""
     trained = default_preset().env
     shown = STEREO_BASELINE_M if STEREO_BASELINE_M in baselines else baselines[0]
-    totals: dict[tuple[float, str], list] = {(b, n): [0, 0, []] for b in baselines for n in configs}
+    totals: dict[tuple[str, float, str], list] = {
+        (",".join(sides), b, n): [0, 0, []] for sides in partners for b in baselines for n in configs}
     for scene in tqdm(scenes, desc="buildings", unit="building"):
         world = PlanningWorld(evaluation_env_config(trained, SceneSet(scene=(scene,))), seed=0)
         rng = np.random.default_rng(0)
         drawn = [draw_viewpoint(trained.low, trained.high, rng) for _ in range(views)]
         for view in drawn:
-            for baseline in baselines:
-                first = scene == scenes[0] and view == drawn[0] and baseline == shown
-                for name, (inside, kept, error) in score_view(world, view, baseline, configs,
-                                                              figure if first else None).items():
-                    total = totals[baseline, name]
-                    total[0], total[1] = total[0] + inside, total[1] + kept
-                    total[2].extend(error)
+            for sides in partners:
+                for baseline in baselines:
+                    first = (scene, view, baseline, sides) == (scenes[0], drawn[0], shown, partners[0])
+                    scores = score_view(world, view, baseline, configs, figure if first else None, sides)
+                    for name, (inside, kept, error) in scores.items():
+                        total = totals[",".join(sides), baseline, name]
+                        total[0], total[1] = total[0] + inside, total[1] + kept
+                        total[2].extend(error)
     return totals
 
 
@@ -127,24 +138,32 @@ def main() -> None:
     parser.add_argument("--scenes", nargs="+", default=list(TRAIN_SCENES[:4]))
     parser.add_argument("--baselines", type=float, nargs="+", default=[0.15, 0.25, 0.4])
     parser.add_argument("--views", type=int, default=8, help="random views per building")
+    parser.add_argument("--partners", nargs="+", default=["back"],
+                        help=f"sets of second frames' sides, comma-joined, from {PARTNER_SIDES}")
+    parser.add_argument("--settings", nargs="+", choices=list(VARIANTS), default=list(VARIANTS),
+                        help="the sweep settings to score")
     parser.add_argument("--out", type=Path, required=True)
     args = parser.parse_args()
     if any(held_out(s) for s in args.scenes):
         raise SystemExit("held-out buildings are not for choosing: give training ones")
-    configs = {name: replace(StereoConfig(), **change) for name, change in VARIANTS.items()}
+    partners = [tuple(sides.split(",")) for sides in args.partners]
+    if not all(set(sides) <= set(PARTNER_SIDES) for sides in partners):
+        raise SystemExit(f"--partners takes comma-joined sides from {PARTNER_SIDES}, got {args.partners}")
+    configs = {name: replace(StereoConfig(), **VARIANTS[name]) for name in args.settings}
     with atomic_folder(args.out, overwrite=True, outputs=("results.json", "results.md", "stereo.png")) as out:
-        totals = measure(args.scenes, args.baselines, args.views, configs, out / "stereo.png")
+        totals = measure(args.scenes, args.baselines, args.views, configs, out / "stereo.png", partners)
         rows, records = [], []
-        for (baseline, name), (inside, kept, error) in totals.items():
-            record = {"baseline_m": baseline, "setting": name, "measured": kept / max(inside, 1),
+        for (sides, baseline, name), (inside, kept, error) in totals.items():
+            record = {"partners": sides, "baseline_m": baseline, "setting": name,
+                      "measured": kept / max(inside, 1),
                       "median_error": float(np.median(error)) if error else None,
                       "wrong": float(np.mean(np.array(error) > 0.05)) if error else None}
             records.append(record)
-            rows.append([f"{baseline:g}", name, f"{100 * record['measured']:.1f}",
+            rows.append([sides, f"{baseline:g}", name, f"{100 * record['measured']:.1f}",
                          "-" if not error else f"{100 * record['median_error']:.2f}",
                          "-" if not error else f"{100 * record['wrong']:.1f}"])
-        table = markdown_table(["baseline (m)", "setting", "measured %", "median error %", "wrong (> 5 %) %"],
-                               rows)
+        table = markdown_table(["partners", "baseline (m)", "setting", "measured %", "median error %",
+                                "wrong (> 5 %) %"], rows)
         command = portable_record({k: str(v) for k, v in vars(args).items()})
         write_json(out / "results.json", {"command": command, "commit": git_commit(), "results": records})
         write_text(out / "results.md", f"# Plane-sweep stereo depth on training buildings\n\n{table}\n\n"

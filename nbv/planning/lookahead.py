@@ -65,6 +65,10 @@ of six checks, the largest margin over the tuned ring, +3.8 points)."""
 STEREO_BASELINE_M = 0.25
 """How far along the orbit `lookahead-stereo` takes each view's second frame, metres (chosen with the sweep's
 settings on four training buildings, paper_results/selection/round25/stereo_depth)."""
+STEREO_PARTNERS = ("back",)
+"""Where `lookahead-stereo` takes each view's second frames, `STEREO_BASELINE_M` from it (`PARTNER_SIDES`)."""
+PARTNER_SIDES = ("back", "forward", "up")
+"""Back or forward along the view's orbit, or up its meridian."""
 DEPTH_SOURCES = ("camera", "stereo")
 """Where the look-ahead's depth comes from: a depth camera, or plane-sweep stereo on two frames a view."""
 
@@ -76,16 +80,20 @@ class LookaheadPlanner(Planner):
 
     def __init__(self, flight: float = LOOKAHEAD_FLIGHT, grid: int = LOOKAHEAD_GRID,
                  rays: int = LOOKAHEAD_RAYS, default_views: int = 13, distinct: bool = False,
-                 depth: str = "camera", blank_images: bool = False) -> None:
+                 depth: str = "camera", blank_images: bool = False,
+                 partners: tuple[str, ...] = STEREO_PARTNERS) -> None:
         """The flight weight a metre, the grid's voxels along its longest side, the rays across the image;
         `distinct`: never step onto a view already flown (else staying put may win where the flight costs
         more than the grid says is left); `depth`: one of `DEPTH_SOURCES`; `blank_images`: with stereo,
-        every captured frame replaced by a blank one (the evaluation's test that it looks)."""
+        every captured frame replaced by a blank one (the evaluation's test that it looks); `partners`: with
+        stereo, the sides of the view its second frames are taken on (`PARTNER_SIDES`), each swept with it."""
         if not 0 <= flight < float("inf") or grid < 1 or rays < 1 or depth not in DEPTH_SOURCES:
             raise ValueError(f"lookahead needs a finite flight weight >= 0, grid >= 1, rays >= 1 and depth "
                              f"from {DEPTH_SOURCES}, got {flight}, {grid}, {rays}, {depth!r}")
+        if not partners or not set(partners) <= set(PARTNER_SIDES):
+            raise ValueError(f"lookahead-stereo's partners are sides from {PARTNER_SIDES}, got {partners}")
         self.flight, self.grid, self.rays, self.default_views = flight, grid, rays, default_views
-        self.distinct, self.depth, self.blank_images = distinct, depth, blank_images
+        self.distinct, self.depth, self.blank_images, self.partners = distinct, depth, blank_images, partners
         if depth == "stereo":
             self.name = "lookahead-stereo"
 
@@ -96,8 +104,14 @@ class LookaheadPlanner(Planner):
         grid = target_grid(world.target, OccupancyConfig(grid_resolution=self.grid, gain_ray_stride=stride))
         steps = replace(world.env, action_mode="orbit", relative_step=ORBIT_STEP)
 
+        seen: dict[tuple[float, float, float], np.ndarray] = {}  # this step's views (the grid is fixed)
+
         def sees(view: Viewpoint) -> np.ndarray:
-            return grid.reached(camera.K, viewpoint_to_c2w(view, center), camera.width, camera.height, stride)
+            key = (round(view.radius, 9), round(view.azimuth % (2 * np.pi), 9), round(view.elevation, 9))
+            if key not in seen:
+                seen[key] = grid.reached(camera.K, viewpoint_to_c2w(view, center), camera.width,
+                                         camera.height, stride)
+            return seen[key]
 
         def step(action: np.ndarray, view: Viewpoint) -> Viewpoint:
             return action_to_viewpoint(action, view, steps)
@@ -105,6 +119,7 @@ class LookaheadPlanner(Planner):
         view, chosen = world.start, [world.start]
         for left in range((self.default_views if views is None else views) - 1, 0, -1):
             self.measure(world, grid, view)
+            seen.clear()
             known = grid.state.reshape(-1) != UNKNOWN
             scores = expert_scores(view, known, sees, step, self.flight, left, HORIZON, DISCOUNT,
                                    flown_m=shell_path(chosen[0], chosen[1:]).total_m)
@@ -118,27 +133,43 @@ class LookaheadPlanner(Planner):
 
     def measure(self, world: PlanningWorld, grid: OccupancyGrid, view: Viewpoint) -> None:
         """Fuse what the UAV measures at `view` into the grid: the depth camera's image, or stereo depth of
-        the view and its second frame."""
+        the view and each of its second frames (every pair swept apart, both frames' depth fused)."""
         camera, center, stride = world.camera, world.target.center(), OccupancyConfig().integrate_ray_stride
         if self.depth == "camera":
             grid.integrate(world.source.render_depth(view), camera.K, viewpoint_to_c2w(view, center), stride)
             return
-        frames = (view, stereo_partner(view))
-        poses = [viewpoint_to_c2w(v, center) for v in frames]
-        images = [np.zeros((camera.height, camera.width)) if self.blank_images
-                  else grayscale(world.source.render_rgb(v)) for v in frames]
-        ranges = [box_depth_range(grid.lower, grid.upper, pose) for pose in poses]
-        near, far = min(r[0] for r in ranges), max(r[1] for r in ranges)
-        depths = two_view_depth(*images, camera.K, *poses, near, far, StereoConfig())
-        for depth, pose in zip(depths, poses, strict=True):
-            grid.integrate(depth, camera.K, pose, stride)
+
+        def frame(v: Viewpoint) -> np.ndarray:
+            return np.zeros((camera.height, camera.width)) if self.blank_images \
+                else grayscale(world.source.render_rgb(v))
+
+        image, pose = frame(view), viewpoint_to_c2w(view, center)
+        for side in self.partners:
+            partner = stereo_partner(view, side=side)
+            other = viewpoint_to_c2w(partner, center)
+            for depth, at in zip(stereo_depth(image, frame(partner), camera.K, pose, other, grid),
+                                 (pose, other), strict=True):
+                grid.integrate(depth, camera.K, at, stride)
 
 
-def stereo_partner(view: Viewpoint, baseline: float = STEREO_BASELINE_M) -> Viewpoint:
-    """The view's second frame: `baseline` metres (a chord) back along its orbit, at its radius and
-    elevation."""
+def stereo_depth(image: np.ndarray, other: np.ndarray, K: np.ndarray, pose: np.ndarray,  # noqa: N803
+                 other_pose: np.ndarray, grid: OccupancyGrid) -> tuple[np.ndarray, np.ndarray]:
+    """Both frames' stereo depth (NaN where not measured), swept between the grid box's nearest and farthest
+    depths from either frame."""
+    ranges = [box_depth_range(grid.lower, grid.upper, p) for p in (pose, other_pose)]
+    near, far = min(r[0] for r in ranges), max(r[1] for r in ranges)
+    return two_view_depth(image, other, K, pose, other_pose, near, far, StereoConfig())
+
+
+def stereo_partner(view: Viewpoint, baseline: float = STEREO_BASELINE_M, side: str = "back") -> Viewpoint:
+    """The view's second frame `baseline` metres (a chord) from it on `side`: back or forward along its
+    orbit (its radius and elevation kept), or up its meridian (its radius and azimuth kept)."""
+    if side == "up":
+        return Viewpoint(view.radius, view.azimuth,
+                         view.elevation + 2 * np.arcsin(min(baseline / (2 * view.radius), 1.0)))
     horizontal = max(view.radius * np.cos(view.elevation), baseline)
-    return Viewpoint(view.radius, view.azimuth - 2 * np.arcsin(baseline / (2 * horizontal)), view.elevation)
+    turn = 2 * np.arcsin(baseline / (2 * horizontal))
+    return Viewpoint(view.radius, view.azimuth + (turn if side == "forward" else -turn), view.elevation)
 
 
 def revisits(view: Viewpoint, flown: list[Viewpoint], tolerance: float = 1e-6) -> bool:

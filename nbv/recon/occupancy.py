@@ -102,8 +102,8 @@ class OccupancyGrid:
                 stride: int = 1) -> np.ndarray:
         """Which voxels (flat bool, the grid's size) are unknown and reached by every `stride`-th pixel's ray
         before an occupied voxel: the voxels `gain` counts."""
-        origin, rays = self._rays(K, c2w, width, height)
-        rays = rays[::stride, ::stride].reshape(-1, 3)
+        origin, rays = self._rays(K, c2w, width, height, stride)
+        rays = rays.reshape(-1, 3)
         flat = self.state.reshape(-1)
         reached = np.zeros(flat.size, dtype=bool)
         for index, valid in self._walk(origin, rays / np.linalg.norm(rays, axis=-1, keepdims=True),
@@ -124,10 +124,11 @@ class OccupancyGrid:
         return np.ravel_multi_index(np.moveaxis(ijk, -1, 0), self.state.shape)
 
     def _rays(self, K: np.ndarray, c2w: np.ndarray, width: int,  # noqa: N803
-              height: int) -> tuple[np.ndarray, np.ndarray]:
-        """The camera centre and the (H, W, 3) world directions of the pixel rays, unit z in the camera."""
+              height: int, stride: int = 1) -> tuple[np.ndarray, np.ndarray]:
+        """The camera centre and the world directions of every `stride`-th pixel's ray ((H, W, 3) at stride
+        1), unit z in the camera."""
         pose = validate_pose(c2w)
-        return pose[:3, 3], pixel_rays(K, width, height) @ pose[:3, :3].T
+        return pose[:3, 3], pixel_rays(K, width, height)[::stride, ::stride] @ pose[:3, :3].T
 
     def _walk(self, origin: np.ndarray, directions: np.ndarray,
               ends: np.ndarray) -> Iterator[tuple[np.ndarray, np.ndarray]]:
@@ -151,8 +152,8 @@ class OccupancyGrid:
             samples = int(np.ceil((leave[part] - enter[part]).max(initial=0.0) / step))
             t = (enter[part, None] + (np.arange(samples) + 0.5) * step).astype(np.float32)
             valid = t < leave[part, None]
-            index = np.zeros(t.shape, dtype=np.int64)
+            index = np.zeros(t.shape, dtype=np.int32)
             for axis in range(3):
-                cell = np.floor(start[axis] + t * units[part, axis, None]).astype(np.int64)
-                index += np.clip(cell, 0, shape[axis] - 1) * strides[axis]
+                cell = np.floor(start[axis] + t * units[part, axis, None]).astype(np.int32)
+                index += np.clip(cell, 0, shape[axis] - 1, out=cell) * np.int32(strides[axis])
             yield index, valid

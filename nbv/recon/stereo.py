@@ -68,8 +68,11 @@ def box_depth_range(lower: np.ndarray, upper: np.ndarray, c2w: np.ndarray) -> tu
 
 
 def _window_mean(x: torch.Tensor, window: int) -> torch.Tensor:
-    """Mean of (N, H, W) images over square windows (the window shrinks at the border)."""
-    return F.avg_pool2d(x[:, None], window, 1, window // 2, count_include_pad=False)[:, 0]
+    """Mean of (N, H, W) images over square windows (the window shrinks at the border): a row pass, then a
+    column pass (separable, so 2 x `window` reads a pixel instead of `window` squared)."""
+    half = window // 2
+    rows = F.avg_pool2d(x[:, None], (1, window), 1, (0, half), count_include_pad=False)
+    return F.avg_pool2d(rows, (window, 1), 1, (half, 0), count_include_pad=False)[:, 0]
 
 
 def _window_stats(x: torch.Tensor, window: int) -> tuple[torch.Tensor, torch.Tensor]:
@@ -83,10 +86,12 @@ def _project(depth: torch.Tensor, K: np.ndarray, ref_c2w: np.ndarray,  # noqa: N
     """Where the reference pixels at z-depths `depth` (..., H, W) land in the source: pixel (u, v) and
     z-depth, (..., H, W, 2) and (..., H, W)."""
     relative = np.linalg.inv(validate_pose(src_c2w)) @ validate_pose(ref_c2w)
-    rays = torch.as_tensor(pixel_rays(K, width, height) @ relative[:3, :3].T, dtype=torch.float32)
-    cam = depth[..., None] * rays + torch.as_tensor(relative[:3, 3], dtype=torch.float32)
-    z = cam[..., 2]
-    pixels = cam @ torch.as_tensor(np.asarray(K, np.float64).T, dtype=torch.float32)
+    k = np.asarray(K, np.float64)
+    # K (d R r + t) = d (K R r) + K t: one (H, W, 3) product, then a multiply-add per depth.
+    rays = torch.as_tensor(pixel_rays(k, width, height) @ (k @ relative[:3, :3]).T, dtype=torch.float32)
+    offset = torch.as_tensor(k @ relative[:3, 3], dtype=torch.float32)
+    pixels = depth[..., None] * rays + offset
+    z = pixels[..., 2]
     return pixels[..., :2] / z.clamp(min=1e-9)[..., None], z
 
 

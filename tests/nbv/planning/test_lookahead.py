@@ -95,6 +95,34 @@ def test_the_second_frame_is_the_baseline_back_along_the_orbit():
     assert azimuth_step(view.azimuth, partner.azimuth) < 0  # back: clockwise
 
 
+@pytest.mark.parametrize("side", ["forward", "up"])
+def test_other_second_frames_are_the_baseline_forward_or_up(side):
+    view, centre = Viewpoint(2.0, 0.1, 0.5), np.zeros(3)
+    partner = stereo_partner(view, side=side)
+    chord = viewpoint_to_c2w(view, centre)[:3, 3] - viewpoint_to_c2w(partner, centre)[:3, 3]
+    assert np.linalg.norm(chord) == pytest.approx(STEREO_BASELINE_M)
+    assert partner.radius == view.radius
+    if side == "up":  # up the meridian: same azimuth, higher
+        assert partner.azimuth == view.azimuth and partner.elevation > view.elevation
+    else:  # the mirror of back
+        assert partner.elevation == view.elevation
+        assert azimuth_step(view.azimuth, partner.azimuth) == pytest.approx(
+            -azimuth_step(view.azimuth, stereo_partner(view).azimuth))
+
+
+def test_more_second_frames_measure_at_least_as_much():
+    known = {}
+    for partners in (("back",), ("back", "up")):
+        world = PlanningWorld(config(camera=UAVCamera(160, 120), render=RenderSettings(spp=4)), seed=3)
+        grid = target_grid(world.target, OccupancyConfig(grid_resolution=16))
+        LookaheadPlanner(grid=16, rays=8, depth="stereo", partners=partners).measure(world, grid, world.start)
+        known[partners] = grid.state != UNKNOWN
+    assert known["back", "up"].sum() > known["back",].sum()
+    assert np.all(known["back", "up"][known["back",]])  # the first pair's knowledge is kept
+    with pytest.raises(ValueError, match="partners are sides from"):
+        LookaheadPlanner(depth="stereo", partners=("down",))
+
+
 def test_stereo_measures_the_building_and_blank_frames_measure_nothing():
     world = PlanningWorld(config(camera=UAVCamera(160, 120), render=RenderSettings(spp=4)), seed=3)
     known = {}

@@ -8,7 +8,8 @@ points of the grid's voxels a metre), grid resolutions and ray strides (every n-
 preset's 160 x 120) on the validation buildings, scored as `scripts/looks_eval.py` scores every planner;
 round 23 chose `lookahead`'s setting with it. With `--stereo`, each weight is also flown on the depth that
 plane-sweep stereo finds between two frames a view (`lookahead-stereo`, name ending _stereo), and again with
-every frame blank (round 25).
+every frame blank (round 25); `--partners back up` takes its second frames on those sides (round 26; name
+ending _stereo_back-up).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -21,7 +22,7 @@ from pathlib import Path
 
 from common.io import atomic_folder
 from nbv.planning.config import PlanSettings
-from nbv.planning.lookahead import LookaheadPlanner
+from nbv.planning.lookahead import PARTNER_SIDES, STEREO_PARTNERS, LookaheadPlanner
 from nbv.planning.registry import make_planner
 from nbv.rl.presets import default_preset
 
@@ -40,6 +41,8 @@ def main() -> None:
                         help="also fly each weight on stereo depth from the images (name ending _stereo)")
     parser.add_argument("--no-camera", action="store_true",
                         help="with --stereo, fly only the stereo look-ahead (not the depth camera's)")
+    parser.add_argument("--partners", nargs="+", choices=PARTNER_SIDES, default=list(STEREO_PARTNERS),
+                        help="with --stereo, the sides of each view's second frames")
     looks_eval.study_arguments(parser)
     args = parser.parse_args()
     looks_eval.refuse_held_out(args.scenes)
@@ -47,6 +50,8 @@ def main() -> None:
     rays = max(1, trained.camera.width // args.gain_ray_stride)
     planners = {name: (make_planner(name, PlanSettings()), False) for name in ("orbit", "orbit2", "random")}
     names, blanks = [], {}
+    partners = tuple(args.partners)
+    suffix = "_stereo" + ("" if partners == STEREO_PARTNERS else "_" + "-".join(partners))
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"
         for distinct in () if args.no_camera else (False, True) if args.distinct else (False,):
@@ -55,9 +60,10 @@ def main() -> None:
             names.append(name + "_d" * distinct)
         if args.stereo:
             stereo = {blank: LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays, depth="stereo",
-                                              blank_images=blank) for blank in (False, True)}
-            planners[name + "_stereo"], blanks[name + "_stereo"] = (stereo[False], False), stereo[True]
-            names.append(name + "_stereo")
+                                              blank_images=blank, partners=partners)
+                      for blank in (False, True)}
+            planners[name + suffix], blanks[name + suffix] = (stereo[False], False), stereo[True]
+            names.append(name + suffix)
     results = looks_eval.evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work,
                                   blanks=blanks)
     checks = looks_eval.policy_acceptance(results, args.scenes, names)

@@ -20,6 +20,7 @@ AREAS = (
     "recon",
     "threads",
     "rl",
+    "lookahead",
     "fanout",
 )
 """Bench modules under `nbv.bench`, run in this order."""
@@ -30,7 +31,8 @@ class BenchResult:
     """One measured figure."""
 
     area: str
-    """The bench module that measured it (cli, render, scenes, bov, recon, threads, rl, fanout)."""
+    """The bench module that measured it (cli, render, scenes, bov, recon, threads, rl, lookahead,
+    fanout)."""
     name: str
     """What was measured, with its settings (e.g. 'RGB-D views/s llvm_ad_rgb 320x240 steady')."""
     value: float

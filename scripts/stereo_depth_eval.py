@@ -21,7 +21,8 @@ them wrong.
 
 With `--partners`, each view is also swept with second frames on other sides (`back,up`: one back along
 the orbit, one up the meridian, each swept with the view; a pixel counts as measured if any pair measures
-it, and every pair's kept depths count towards the errors, as the grid fuses each).
+it, and every pair's kept depths count towards the errors, as the grid fuses each); `back,forward,up@2`
+keeps only the depth that at least two pairs agree on (`nbv.recon.stereo.agreed_depth`; round 26).
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import git_commit, portable_record
 from nbv.planning.lookahead import PARTNER_SIDES, STEREO_BASELINE_M, stereo_partner
 from nbv.planning.world import PlanningWorld
-from nbv.recon.stereo import StereoConfig, box_depth_range, grayscale, two_view_depth
+from nbv.recon.stereo import StereoConfig, agreed_depth, box_depth_range, grayscale, two_view_depth
 from nbv.rl.presets import TRAIN_SCENES, default_preset
 from nbv.rl.validate import evaluation_env_config
 from nbv.viz.figures import save_figure
@@ -58,10 +59,11 @@ least correlation of 0.7, and chose the last)."""
 
 
 def score_view(world: PlanningWorld, view, baseline: float, configs: dict[str, StereoConfig],
-               figure: Path | None = None, sides: tuple[str, ...] = ("back",)) -> dict:
+               figure: Path | None = None, sides: tuple[str, ...] = ("back",), agree: int = 0) -> dict:
     """Each setting's (target pixels, kept, errors) on one view swept with its second frame on each of
-    `sides` (kept: measured by any pair; errors: every pair's kept depths, as the grid fuses each); with
-    `figure`, the view's picture of the default setting written there."""
+    `sides` (kept: measured by any pair; errors: every pair's kept depths, as the grid fuses each; with
+    `agree` >= 1, the one depth that many pairs agree on, `agreed_depth`); with `figure`, the view's picture
+    of the default setting written there."""
     target, camera = world.target, world.camera
     lower, upper = target.bounds()
     pose = viewpoint_to_c2w(view, target.center())
@@ -74,11 +76,15 @@ def score_view(world: PlanningWorld, view, baseline: float, configs: dict[str, S
     inside = (exact > 0) & np.all((points >= lower - 1e-3) & (points <= upper + 1e-3), axis=-1)
     scores = {}
     for name, config in configs.items():
-        kept, errors, depth = np.zeros_like(inside), [], None
+        depths = []
         for other, partner in zip(others, partners, strict=True):
             ranges = [box_depth_range(lower, upper, p) for p in (pose, other)]
             near, far = min(r[0] for r in ranges), max(r[1] for r in ranges)
-            depth = two_view_depth(image, partner, camera.K, pose, other, near, far, config)[0]
+            depths.append(two_view_depth(image, partner, camera.K, pose, other, near, far, config)[0])
+        if agree:
+            depths = [agreed_depth(depths, config.consistency, agree)]
+        kept, errors = np.zeros_like(inside), []
+        for depth in depths:
             pair = np.isfinite(depth) & inside
             kept |= pair
             errors.extend((np.abs(depth[pair] - exact[pair]) / exact[pair]).tolist())
@@ -109,28 +115,41 @@ def depth_figure(image: np.ndarray, exact: np.ndarray, stereo: np.ndarray, insid
 
 
 def measure(scenes: list[str], baselines: list[float], views: int, configs: dict[str, StereoConfig],
-            figure: Path, partners: list[tuple[str, ...]]) -> dict[tuple[str, float, str], list]:
+            figure: Path, partners: list[str]) -> dict[tuple[str, float, str], list]:
     """Per (partner sides, baseline, setting): target pixels, kept pixels and the kept depths' relative
     errors, summed over `views` random views of each building (the picture of the first building's first
-    view at the shipped baseline, or the first, with the first partners, written to `figure`)."""
+    view at the shipped baseline, or the first, with the first partners, written to `figure`); a set of
+    partners is sides, comma-joined, and @N to keep only depths N pairs agree on (`partner_set`)."""
     trained = default_preset().env
     shown = STEREO_BASELINE_M if STEREO_BASELINE_M in baselines else baselines[0]
     totals: dict[tuple[str, float, str], list] = {
-        (",".join(sides), b, n): [0, 0, []] for sides in partners for b in baselines for n in configs}
+        (spec, b, n): [0, 0, []] for spec in partners for b in baselines for n in configs}
     for scene in tqdm(scenes, desc="buildings", unit="building"):
         world = PlanningWorld(evaluation_env_config(trained, SceneSet(scene=(scene,))), seed=0)
         rng = np.random.default_rng(0)
         drawn = [draw_viewpoint(trained.low, trained.high, rng) for _ in range(views)]
         for view in drawn:
-            for sides in partners:
+            for spec in partners:
                 for baseline in baselines:
-                    first = (scene, view, baseline, sides) == (scenes[0], drawn[0], shown, partners[0])
-                    scores = score_view(world, view, baseline, configs, figure if first else None, sides)
+                    first = (scene, view, baseline, spec) == (scenes[0], drawn[0], shown, partners[0])
+                    scores = score_view(world, view, baseline, configs, figure if first else None,
+                                        *partner_set(spec))
                     for name, (inside, kept, error) in scores.items():
-                        total = totals[",".join(sides), baseline, name]
+                        total = totals[spec, baseline, name]
                         total[0], total[1] = total[0] + inside, total[1] + kept
                         total[2].extend(error)
     return totals
+
+
+def partner_set(spec: str) -> tuple[tuple[str, ...], int]:
+    """`back,up` -> the sides and 0 (every pair's depth kept); `back,forward,up@2` -> the sides and 2 (only
+    depths two pairs agree on)."""
+    sides, _, agree = spec.partition("@")
+    parts = tuple(sides.split(","))
+    if not set(parts) <= set(PARTNER_SIDES) or not (agree == "" or agree.isdigit()):
+        raise ValueError(f"--partners takes comma-joined sides from {PARTNER_SIDES}, then @N or nothing, "
+                         f"got {spec!r}")
+    return parts, int(agree or 0)
 
 
 def main() -> None:
@@ -146,12 +165,13 @@ def main() -> None:
     args = parser.parse_args()
     if any(held_out(s) for s in args.scenes):
         raise SystemExit("held-out buildings are not for choosing: give training ones")
-    partners = [tuple(sides.split(",")) for sides in args.partners]
-    if not all(set(sides) <= set(PARTNER_SIDES) for sides in partners):
-        raise SystemExit(f"--partners takes comma-joined sides from {PARTNER_SIDES}, got {args.partners}")
+    try:
+        [partner_set(spec) for spec in args.partners]
+    except ValueError as error:
+        raise SystemExit(str(error)) from None
     configs = {name: replace(StereoConfig(), **VARIANTS[name]) for name in args.settings}
     with atomic_folder(args.out, overwrite=True, outputs=("results.json", "results.md", "stereo.png")) as out:
-        totals = measure(args.scenes, args.baselines, args.views, configs, out / "stereo.png", partners)
+        totals = measure(args.scenes, args.baselines, args.views, configs, out / "stereo.png", args.partners)
         rows, records = [], []
         for (sides, baseline, name), (inside, kept, error) in totals.items():
             record = {"partners": sides, "baseline_m": baseline, "setting": name,

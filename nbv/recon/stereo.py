@@ -165,3 +165,18 @@ def two_view_depth(ref: np.ndarray, src: np.ndarray, K: np.ndarray, ref_c2w: np.
     keep_first = _consistent(first, second, K, ref_c2w, src_c2w, config.consistency)
     keep_second = _consistent(second, first, K, src_c2w, ref_c2w, config.consistency)
     return np.where(keep_first, first, np.nan), np.where(keep_second, second, np.nan)
+
+
+def agreed_depth(depths: list[np.ndarray], tolerance: float, least: int = 2) -> np.ndarray:
+    """One view's depth from several pairs' (each (H, W), NaN where that pair measured nothing): per pixel,
+    the mean of the largest group of pairs within a relative `tolerance` of one of them, kept where that
+    group has at least `least` pairs (NaN elsewhere). With two or more, a depth that only one pair's false
+    match gives is dropped."""
+    stack = np.stack([np.asarray(d, np.float32) for d in depths])
+    with np.errstate(invalid="ignore"):
+        near = np.abs(stack[:, None] - stack[None]) <= tolerance * stack[:, None]  # (anchor, pair, H, W)
+    counts = near.sum(axis=1)
+    anchor = counts.argmax(axis=0)
+    group = np.take_along_axis(near, anchor[None, None], axis=0)[0]
+    mean = np.where(group, stack, 0.0).sum(axis=0) / np.maximum(group.sum(axis=0), 1)
+    return np.where(group.sum(axis=0) >= least, mean, np.nan).astype(np.float32)

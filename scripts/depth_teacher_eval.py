@@ -8,8 +8,8 @@ points of the grid's voxels a metre), grid resolutions and ray strides (every n-
 preset's 160 x 120) on the validation buildings, scored as `scripts/looks_eval.py` scores every planner;
 round 23 chose `lookahead`'s setting with it. With `--stereo`, each weight is also flown on the depth that
 plane-sweep stereo finds between two frames a view (`lookahead-stereo`, name ending _stereo), and again with
-every frame blank (round 25); `--partners back up` takes its second frames on those sides (round 26; name
-ending _stereo_back-up).
+every frame blank (round 25); `--partners back up` takes its second frames on those sides and `--agree N`
+fuses only depths N pairs agree on (round 26; name ending _stereo_back-up, _stereo_back-up_a2).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -43,6 +43,8 @@ def main() -> None:
                         help="with --stereo, fly only the stereo look-ahead (not the depth camera's)")
     parser.add_argument("--partners", nargs="+", choices=PARTNER_SIDES, default=list(STEREO_PARTNERS),
                         help="with --stereo, the sides of each view's second frames")
+    parser.add_argument("--agree", type=int, default=0,
+                        help="with --stereo, fuse only the depths this many pairs agree on (0: every pair's)")
     looks_eval.study_arguments(parser)
     args = parser.parse_args()
     looks_eval.refuse_held_out(args.scenes)
@@ -51,7 +53,8 @@ def main() -> None:
     planners = {name: (make_planner(name, PlanSettings()), False) for name in ("orbit", "orbit2", "random")}
     names, blanks = [], {}
     partners = tuple(args.partners)
-    suffix = "_stereo" + ("" if partners == STEREO_PARTNERS else "_" + "-".join(partners))
+    suffix = "_stereo" + ("" if partners == STEREO_PARTNERS else "_" + "-".join(partners)) \
+        + (f"_a{args.agree}" if args.agree else "")
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"
         for distinct in () if args.no_camera else (False, True) if args.distinct else (False,):
@@ -60,7 +63,7 @@ def main() -> None:
             names.append(name + "_d" * distinct)
         if args.stereo:
             stereo = {blank: LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays, depth="stereo",
-                                              blank_images=blank, partners=partners)
+                                              blank_images=blank, partners=partners, agree=args.agree)
                       for blank in (False, True)}
             planners[name + suffix], blanks[name + suffix] = (stereo[False], False), stereo[True]
             names.append(name + suffix)

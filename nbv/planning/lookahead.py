@@ -41,7 +41,7 @@ from nbv.planning.base import Planner
 from nbv.planning.infogain import target_grid
 from nbv.recon.config import OccupancyConfig
 from nbv.recon.occupancy import UNKNOWN, OccupancyGrid
-from nbv.recon.stereo import StereoConfig, box_depth_range, grayscale, two_view_depth
+from nbv.recon.stereo import StereoConfig, agreed_depth, box_depth_range, grayscale, two_view_depth
 from nbv.rl.env import action_to_viewpoint
 from nbv.rl.expert import CANDIDATES, best_action, expert_scores
 from nbv.rl.presets import ORBIT_STEP
@@ -67,6 +67,8 @@ STEREO_BASELINE_M = 0.25
 settings on four training buildings, paper_results/selection/round25/stereo_depth)."""
 STEREO_PARTNERS = ("back",)
 """Where `lookahead-stereo` takes each view's second frames, `STEREO_BASELINE_M` from it (`PARTNER_SIDES`)."""
+STEREO_AGREE = 0
+"""How many pairs must agree on a depth for `lookahead-stereo` to fuse it (0: every pair's depth is fused)."""
 PARTNER_SIDES = ("back", "forward", "up")
 """Back or forward along the view's orbit, or up its meridian."""
 DEPTH_SOURCES = ("camera", "stereo")
@@ -81,19 +83,23 @@ class LookaheadPlanner(Planner):
     def __init__(self, flight: float = LOOKAHEAD_FLIGHT, grid: int = LOOKAHEAD_GRID,
                  rays: int = LOOKAHEAD_RAYS, default_views: int = 13, distinct: bool = False,
                  depth: str = "camera", blank_images: bool = False,
-                 partners: tuple[str, ...] = STEREO_PARTNERS) -> None:
+                 partners: tuple[str, ...] = STEREO_PARTNERS, agree: int = STEREO_AGREE) -> None:
         """The flight weight a metre, the grid's voxels along its longest side, the rays across the image;
         `distinct`: never step onto a view already flown (else staying put may win where the flight costs
         more than the grid says is left); `depth`: one of `DEPTH_SOURCES`; `blank_images`: with stereo,
         every captured frame replaced by a blank one (the evaluation's test that it looks); `partners`: with
-        stereo, the sides of the view its second frames are taken on (`PARTNER_SIDES`), each swept with it."""
+        stereo, the sides of the view its second frames are taken on (`PARTNER_SIDES`), each swept with it;
+        `agree`: 0 fuses every pair's depth of both its frames, N >= 1 only the view's depth that N pairs
+        agree on (`agreed_depth`)."""
         if not 0 <= flight < float("inf") or grid < 1 or rays < 1 or depth not in DEPTH_SOURCES:
             raise ValueError(f"lookahead needs a finite flight weight >= 0, grid >= 1, rays >= 1 and depth "
                              f"from {DEPTH_SOURCES}, got {flight}, {grid}, {rays}, {depth!r}")
-        if not partners or not set(partners) <= set(PARTNER_SIDES):
-            raise ValueError(f"lookahead-stereo's partners are sides from {PARTNER_SIDES}, got {partners}")
+        if not partners or not set(partners) <= set(PARTNER_SIDES) or not 0 <= agree <= len(partners):
+            raise ValueError(f"lookahead-stereo's partners are sides from {PARTNER_SIDES} and agree 0 to "
+                             f"their number, got {partners}, {agree}")
         self.flight, self.grid, self.rays, self.default_views = flight, grid, rays, default_views
-        self.distinct, self.depth, self.blank_images, self.partners = distinct, depth, blank_images, partners
+        self.distinct, self.depth, self.blank_images = distinct, depth, blank_images
+        self.partners, self.agree = partners, agree
         if depth == "stereo":
             self.name = "lookahead-stereo"
 
@@ -133,7 +139,8 @@ class LookaheadPlanner(Planner):
 
     def measure(self, world: PlanningWorld, grid: OccupancyGrid, view: Viewpoint) -> None:
         """Fuse what the UAV measures at `view` into the grid: the depth camera's image, or stereo depth of
-        the view and each of its second frames (every pair swept apart, both frames' depth fused)."""
+        the view and each of its second frames (every pair swept apart; both frames' depth fused, or with
+        `agree` only the view's depth that many pairs agree on)."""
         camera, center, stride = world.camera, world.target.center(), OccupancyConfig().integrate_ray_stride
         if self.depth == "camera":
             grid.integrate(world.source.render_depth(view), camera.K, viewpoint_to_c2w(view, center), stride)
@@ -144,12 +151,16 @@ class LookaheadPlanner(Planner):
                 else grayscale(world.source.render_rgb(v))
 
         image, pose = frame(view), viewpoint_to_c2w(view, center)
+        fused, views = [], []
         for side in self.partners:
             partner = stereo_partner(view, side=side)
             other = viewpoint_to_c2w(partner, center)
-            for depth, at in zip(stereo_depth(image, frame(partner), camera.K, pose, other, grid),
-                                 (pose, other), strict=True):
-                grid.integrate(depth, camera.K, at, stride)
+            fused.extend(stereo_depth(image, frame(partner), camera.K, pose, other, grid))
+            views.extend((pose, other))
+        if self.agree:
+            fused, views = [agreed_depth(fused[::2], StereoConfig().consistency, self.agree)], [pose]
+        for depth, at in zip(fused, views, strict=True):
+            grid.integrate(depth, camera.K, at, stride)
 
 
 def stereo_depth(image: np.ndarray, other: np.ndarray, K: np.ndarray, pose: np.ndarray,  # noqa: N803

@@ -121,6 +121,20 @@ def test_more_second_frames_measure_at_least_as_much():
     assert np.all(known["back", "up"][known["back",]])  # the first pair's knowledge is kept
     with pytest.raises(ValueError, match="partners are sides from"):
         LookaheadPlanner(depth="stereo", partners=("down",))
+    with pytest.raises(ValueError, match="agree 0 to their number"):
+        LookaheadPlanner(depth="stereo", partners=("back", "up"), agree=3)
+
+
+def test_fusing_only_what_pairs_agree_on_knows_less_than_every_pair():
+    known = {}
+    for agree in (0, 2):
+        world = PlanningWorld(config(camera=UAVCamera(160, 120), render=RenderSettings(spp=4)), seed=3)
+        grid = target_grid(world.target, OccupancyConfig(grid_resolution=16))
+        planner = LookaheadPlanner(grid=16, rays=8, depth="stereo", partners=("back", "forward", "up"),
+                                   agree=agree)
+        planner.measure(world, grid, world.start)
+        known[agree] = (grid.state != UNKNOWN).sum()
+    assert 0 < known[2] < known[0]
 
 
 def test_stereo_measures_the_building_and_blank_frames_measure_nothing():

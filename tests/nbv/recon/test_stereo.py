@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from nbv.recon.stereo import StereoConfig, box_depth_range, grayscale, sweep, two_view_depth
+from nbv.recon.stereo import StereoConfig, agreed_depth, box_depth_range, grayscale, sweep, two_view_depth
 from render.camera import UAVCamera, pixel_rays
 
 CAMERA = UAVCamera(160, 120)
@@ -89,3 +89,15 @@ def test_box_range_grayscale_and_refusals():
         StereoConfig(window=6)
     with pytest.raises(ValueError, match="0 < near < far"):
         sweep(np.zeros((4, 4)), np.zeros((4, 4)), CAMERA.K, pose(0.0), pose(BASELINE), 2.0, 1.0)
+
+
+def test_pairs_agree_on_a_depth_by_majority_and_a_lone_match_is_dropped():
+    n = np.nan
+    first = np.array([[2.0, 2.0, n, 3.0, n]])
+    second = np.array([[2.02, 2.5, n, n, 1.0]])
+    third = np.array([[1.99, 3.0, 4.0, 3.01, n]])
+    agreed = agreed_depth([first, second, third], 0.02)
+    # all three within 2 % of 2.0: their mean; three pairs disagree; one pair only; two agree; one only
+    np.testing.assert_allclose(agreed, [[(2.0 + 2.02 + 1.99) / 3, n, n, (3.0 + 3.01) / 2, n]], rtol=1e-6)
+    alone = agreed_depth([first, second, third], 0.02, least=1)
+    np.testing.assert_allclose(alone, [[(2.0 + 2.02 + 1.99) / 3, 2.0, 4.0, (3.0 + 3.01) / 2, 1.0]], rtol=1e-6)

@@ -9,7 +9,8 @@ preset's 160 x 120) on the validation buildings, scored as `scripts/looks_eval.p
 round 23 chose `lookahead`'s setting with it. With `--stereo`, each weight is also flown on the depth that
 plane-sweep stereo finds between two frames a view (`lookahead-stereo`, name ending _stereo), and again with
 every frame blank (round 25); `--partners back up` takes its second frames on those sides and `--agree N`
-fuses only depths N pairs agree on (round 26; name ending _stereo_back-up, _stereo_back-up_a2).
+fuses only depths N pairs agree on, `--votes` weighs the grid's hits against passes (round 26; name ending
+_stereo_back-up, _stereo_back-up_a2, _stereo_v).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -45,6 +46,8 @@ def main() -> None:
                         help="with --stereo, the sides of each view's second frames")
     parser.add_argument("--agree", type=int, default=0,
                         help="with --stereo, fuse only the depths this many pairs agree on (0: every pair's)")
+    parser.add_argument("--votes", action="store_true",
+                        help="with --stereo, the grid weighs hits against passes, one vote an image")
     looks_eval.study_arguments(parser)
     args = parser.parse_args()
     looks_eval.refuse_held_out(args.scenes)
@@ -54,7 +57,7 @@ def main() -> None:
     names, blanks = [], {}
     partners = tuple(args.partners)
     suffix = "_stereo" + ("" if partners == STEREO_PARTNERS else "_" + "-".join(partners)) \
-        + (f"_a{args.agree}" if args.agree else "")
+        + (f"_a{args.agree}" if args.agree else "") + ("_v" if args.votes else "")
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"
         for distinct in () if args.no_camera else (False, True) if args.distinct else (False,):
@@ -63,7 +66,8 @@ def main() -> None:
             names.append(name + "_d" * distinct)
         if args.stereo:
             stereo = {blank: LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays, depth="stereo",
-                                              blank_images=blank, partners=partners, agree=args.agree)
+                                              blank_images=blank, partners=partners, agree=args.agree,
+                                              votes=args.votes)
                       for blank in (False, True)}
             planners[name + suffix], blanks[name + suffix] = (stereo[False], False), stereo[True]
             names.append(name + suffix)

@@ -83,14 +83,15 @@ class LookaheadPlanner(Planner):
     def __init__(self, flight: float = LOOKAHEAD_FLIGHT, grid: int = LOOKAHEAD_GRID,
                  rays: int = LOOKAHEAD_RAYS, default_views: int = 13, distinct: bool = False,
                  depth: str = "camera", blank_images: bool = False,
-                 partners: tuple[str, ...] = STEREO_PARTNERS, agree: int = STEREO_AGREE) -> None:
+                 partners: tuple[str, ...] = STEREO_PARTNERS, agree: int = STEREO_AGREE,
+                 votes: bool = False) -> None:
         """The flight weight a metre, the grid's voxels along its longest side, the rays across the image;
         `distinct`: never step onto a view already flown (else staying put may win where the flight costs
         more than the grid says is left); `depth`: one of `DEPTH_SOURCES`; `blank_images`: with stereo,
         every captured frame replaced by a blank one (the evaluation's test that it looks); `partners`: with
         stereo, the sides of the view its second frames are taken on (`PARTNER_SIDES`), each swept with it;
         `agree`: 0 fuses every pair's depth of both its frames, N >= 1 only the view's depth that N pairs
-        agree on (`agreed_depth`)."""
+        agree on (`agreed_depth`); `votes`: the grid weighs hits against passes (`OccupancyConfig.votes`)."""
         if not 0 <= flight < float("inf") or grid < 1 or rays < 1 or depth not in DEPTH_SOURCES:
             raise ValueError(f"lookahead needs a finite flight weight >= 0, grid >= 1, rays >= 1 and depth "
                              f"from {DEPTH_SOURCES}, got {flight}, {grid}, {rays}, {depth!r}")
@@ -99,7 +100,7 @@ class LookaheadPlanner(Planner):
                              f"their number, got {partners}, {agree}")
         self.flight, self.grid, self.rays, self.default_views = flight, grid, rays, default_views
         self.distinct, self.depth, self.blank_images = distinct, depth, blank_images
-        self.partners, self.agree = partners, agree
+        self.partners, self.agree, self.votes = partners, agree, votes
         if depth == "stereo":
             self.name = "lookahead-stereo"
 
@@ -107,7 +108,8 @@ class LookaheadPlanner(Planner):
         """The start view, then each next one the orbit step whose look-ahead on the grid scores best."""
         camera, center = world.camera, world.target.center()
         stride = max(1, round(camera.width / self.rays))
-        grid = target_grid(world.target, OccupancyConfig(grid_resolution=self.grid, gain_ray_stride=stride))
+        grid = target_grid(world.target, OccupancyConfig(grid_resolution=self.grid, gain_ray_stride=stride,
+                                                         votes=self.votes))
         steps = replace(world.env, action_mode="orbit", relative_step=ORBIT_STEP)
 
         seen: dict[tuple[float, float, float], np.ndarray] = {}  # this step's views (the grid is fixed)

@@ -140,6 +140,9 @@ class OccupancyConfig:
     integrate_ray_stride: int = 2
     """A captured depth image carves free space along every n-th pixel's ray along both axes (every
     pixel's hit is marked occupied)."""
+    votes: bool = False
+    """Weigh each image's hits against its rays' passes, one vote an image, instead of occupied winning
+    (`nbv.recon.occupancy`; for stereo depth's false matches)."""
 
     def __post_init__(self) -> None:
         for name in ("grid_resolution", "gain_ray_stride", "integrate_ray_stride"):

@@ -12,6 +12,11 @@ probabilistic:
   no match, `nbv.recon.stereo`) casts no ray and marks nothing. Occupied wins over
   free, now and later: a ray grazing a voxel that holds surface seen elsewhere
   does not clear it (log-odds maps weigh the two; a ternary map must choose).
+  With `votes`, the grid weighs them instead, one vote an image: each image adds a
+  hit to the voxels its pixels hit and a pass to the other voxels its rays cross,
+  and a voxel is occupied while its hits are at least its passes, else free. A
+  false match of stereo (`nbv.recon.stereo`) marks a floater that the rays of
+  later images through it clear; exact depth needs no vote.
 - `gain`: the number of distinct unknown voxels a candidate camera's rays reach,
   each ray stopping at the first occupied voxel: the "unobserved voxel" gain of
   both papers with a hard visibility (free and unknown voxels let the ray on,
@@ -55,9 +60,10 @@ class OccupancyGrid:
         lower: (3,) the box's lower corner, metres.
         upper: (3,) its upper corner; the grid reaches at least this far (whole voxels).
         resolution: voxels along the box's longest side.
+        votes: weigh hits and passes, one vote an image (module docstring), instead of occupied winning.
     """
 
-    def __init__(self, lower: np.ndarray, upper: np.ndarray, resolution: int) -> None:
+    def __init__(self, lower: np.ndarray, upper: np.ndarray, resolution: int, votes: bool = False) -> None:
         self.lower = np.asarray(lower, dtype=np.float64)
         extent = np.asarray(upper, dtype=np.float64) - self.lower
         if extent.shape != (3,) or not np.all(np.isfinite(extent)) or np.any(extent <= 0):
@@ -68,6 +74,8 @@ class OccupancyGrid:
         shape = np.maximum(np.ceil(extent / self.voxel_size - 1e-9), 1).astype(np.int64)
         self.state = np.zeros(tuple(int(n) for n in shape), dtype=np.uint8)
         self.upper = self.lower + shape * self.voxel_size
+        self.votes = votes
+        self.hits, self.passes = (np.zeros(self.state.size if votes else 0, np.uint32) for _ in range(2))
 
     def integrate(self, depth: np.ndarray, K: np.ndarray, c2w: np.ndarray,  # noqa: N803
                   stride: int = 1) -> None:
@@ -75,7 +83,8 @@ class OccupancyGrid:
         camera-to-world `c2w`.
 
         Free space is carved along every `stride`-th measured pixel's ray; every pixel's hit is marked
-        occupied.
+        occupied (with `votes`: the image's hit and pass votes, then each voxel it touched takes the
+        majority).
         """
         depth = np.asarray(depth, dtype=np.float64)
         origin, rays = self._rays(K, c2w, depth.shape[1], depth.shape[0])
@@ -87,11 +96,20 @@ class OccupancyGrid:
         sub_ranges = ranges[step, step].reshape(-1)[measured]
         lengths = lengths[step, step].reshape(-1, 1)[measured]
         flat = self.state.reshape(-1)
+        crossed = np.zeros(flat.size, dtype=bool)
         for index, valid in self._walk(origin, sub_rays / lengths, sub_ranges):
-            free = index[valid]
-            flat[free[flat[free] != OCCUPIED]] = FREE
+            crossed[index[valid]] = True
         hits = origin + rays[depth > 0] * depth[depth > 0, None]
-        flat[self.voxel_index(hits)[self.contains(hits)]] = OCCUPIED
+        hit = np.zeros(flat.size, dtype=bool)
+        hit[self.voxel_index(hits)[self.contains(hits)]] = True
+        if not self.votes:
+            flat[crossed & (flat != OCCUPIED)] = FREE
+            flat[hit] = OCCUPIED
+            return
+        self.passes[crossed & ~hit] += 1
+        self.hits[hit] += 1
+        touched = crossed | hit
+        flat[touched] = np.where(self.hits[touched] >= self.passes[touched], OCCUPIED, FREE)
 
     def gain(self, K: np.ndarray, c2w: np.ndarray, width: int, height: int,  # noqa: N803
              stride: int = 1) -> int:

@@ -135,6 +135,9 @@ def test_fusing_only_what_pairs_agree_on_knows_less_than_every_pair():
         planner.measure(world, grid, world.start)
         known[agree] = (grid.state != UNKNOWN).sum()
     assert 0 < known[2] < known[0]
+    voting = LookaheadPlanner(grid=16, rays=8, depth="stereo", votes=True)
+    assert len(voting.plan(PlanningWorld(config(), seed=3), 3)) == 3
+    assert target_grid(world.target, OccupancyConfig(grid_resolution=16, votes=True)).votes
 
 
 def test_stereo_measures_the_building_and_blank_frames_measure_nothing():

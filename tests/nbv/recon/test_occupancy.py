@@ -43,6 +43,19 @@ def test_no_hit_frees_the_whole_ray_and_a_later_ray_does_not_clear_a_hit():
     assert grid.state[:, 0, 0].tolist() == [FREE, OCCUPIED, OCCUPIED, UNKNOWN]
 
 
+def test_with_votes_later_rays_through_a_floater_clear_it_and_a_surface_seen_twice_holds():
+    grid = OccupancyGrid(np.zeros(3), np.array([4.0, 1.0, 1.0]), resolution=4, votes=True)
+    grid.integrate(np.array([[2.5]], np.float32), ONE_PIXEL, ALONG_X)  # a false match: voxel 1, one hit
+    grid.integrate(np.array([[3.5]], np.float32), ONE_PIXEL, ALONG_X)  # through it to voxel 2: one pass
+    assert grid.state[:, 0, 0].tolist() == [FREE, OCCUPIED, OCCUPIED, UNKNOWN]  # a tie: still occupied
+    grid.integrate(np.array([[3.5]], np.float32), ONE_PIXEL, ALONG_X)  # a second pass outvotes the hit
+    assert grid.state[:, 0, 0].tolist() == [FREE, FREE, OCCUPIED, UNKNOWN]
+    assert grid.hits[:4].tolist() == [0, 1, 2, 0] and grid.passes[:4].tolist() == [3, 2, 0, 0]
+    grid.integrate(np.array([[2.5]], np.float32), ONE_PIXEL, AGAINST_X)  # from the other side: voxel 2 hit
+    assert grid.state[:, 0, 0].tolist() == [FREE, FREE, OCCUPIED, FREE]
+    assert grid.hits[2] == 3 and grid.passes[3] == 1
+
+
 def test_a_pixel_not_measured_carves_and_marks_nothing():
     grid = row_of_four()
     grid.integrate(np.array([[np.nan]], np.float32), ONE_PIXEL, ALONG_X)  # stereo found no match

@@ -177,6 +177,8 @@ def stereo_depth(image: np.ndarray, other: np.ndarray, K: np.ndarray, pose: np.n
 def stereo_partner(view: Viewpoint, baseline: float = STEREO_BASELINE_M, side: str = "back") -> Viewpoint:
     """The view's second frame `baseline` metres (a chord) from it on `side`: back or forward along its
     orbit (its radius and elevation kept), or up its meridian (its radius and azimuth kept)."""
+    if side not in PARTNER_SIDES:
+        raise ValueError(f"a second frame's side is one of {PARTNER_SIDES}, got {side!r}")
     if side == "up":
         return Viewpoint(view.radius, view.azimuth,
                          view.elevation + 2 * np.arcsin(min(baseline / (2 * view.radius), 1.0)))

@@ -123,6 +123,8 @@ def test_more_second_frames_measure_at_least_as_much():
         LookaheadPlanner(depth="stereo", partners=("down",))
     with pytest.raises(ValueError, match="agree 0 to their number"):
         LookaheadPlanner(depth="stereo", partners=("back", "up"), agree=3)
+    with pytest.raises(ValueError, match="side is one of"):
+        stereo_partner(Viewpoint(2.0, 0.1, 0.5), side="left")
 
 
 def test_fusing_only_what_pairs_agree_on_knows_less_than_every_pair():

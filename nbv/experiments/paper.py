@@ -354,6 +354,9 @@ INDEX = (
            "twenty-fifth round: the look-ahead on plane-sweep stereo from the images (lookahead-stereo), its "
            "stereo setting chosen on training buildings and its flight weight on validation ones",
            LOOKS_EVAL),
+    Result("selection/round26/README.md", "selection/round26/three_frames_votes/results.json", "its "
+           "twenty-sixth round: lookahead-stereo with three second frames, two-pair agreement and a voting "
+           "occupancy grid (not adopted)", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

@@ -26,7 +26,10 @@ plane-sweep stereo between the two (`nbv.recon.stereo`) gives both frames' depth
 consistent match; only that depth is fused, the rest stays unknown. It reads images and the poses flown
 (and the target's box), so it is held to every check of the policies, the blank-images one included.
 Held out, scored once (paper_results/online/stereo): 3.8 points above the ring in 1.26x its metres, 31.3
-lost with blank frames, 3.4 under the ring on the walled compound.
+lost with blank frames, 3.4 under the ring on the walled compound. Round 26 (paper_results/selection/round26)
+tried more second frames (`partners`), fusing only depths pairs agree on (`agree`) and a grid that votes
+hits against passes (`votes`) on the validation buildings: each passes the same four checks, so none is the
+default.
 """
 
 from __future__ import annotations

@@ -87,7 +87,8 @@ def _project(depth: torch.Tensor, K: np.ndarray, ref_c2w: np.ndarray,  # noqa: N
     z-depth, (..., H, W, 2) and (..., H, W)."""
     relative = np.linalg.inv(validate_pose(src_c2w)) @ validate_pose(ref_c2w)
     k = np.asarray(K, np.float64)
-    # K (d R r + t) = d (K R r) + K t: one (H, W, 3) product, then a multiply-add per depth.
+    # K (d R r + t) = d (K R r) + K t: one (H, W, 3) product, then a multiply-add per depth; K's last row
+    # (0, 0, 1) leaves the third coordinate the z-depth.
     rays = torch.as_tensor(pixel_rays(k, width, height) @ (k @ relative[:3, :3]).T, dtype=torch.float32)
     offset = torch.as_tensor(k @ relative[:3, 3], dtype=torch.float32)
     pixels = depth[..., None] * rays + offset

@@ -39,7 +39,7 @@ from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import git_commit, portable_record
 from nbv.planning.lookahead import PARTNER_SIDES, STEREO_BASELINE_M, stereo_partner
 from nbv.planning.world import PlanningWorld
-from nbv.recon.stereo import StereoConfig, agreed_depth, box_depth_range, grayscale, two_view_depth
+from nbv.recon.stereo import StereoConfig, agreed_depth, box_stereo_depth, grayscale
 from nbv.rl.presets import TRAIN_SCENES, default_preset
 from nbv.rl.validate import evaluation_env_config
 from nbv.viz.figures import save_figure
@@ -68,19 +68,17 @@ def score_view(world: PlanningWorld, view, baseline: float, configs: dict[str, S
     lower, upper = target.bounds()
     pose = viewpoint_to_c2w(view, target.center())
     image = grayscale(world.source.render_rgb(view))
-    others = [viewpoint_to_c2w(stereo_partner(view, baseline, side), target.center()) for side in sides]
-    partners = [grayscale(world.source.render_rgb(stereo_partner(view, baseline, side))) for side in sides]
+    seconds = [stereo_partner(view, baseline, side) for side in sides]
+    others = [viewpoint_to_c2w(second, target.center()) for second in seconds]
+    partners = [grayscale(world.source.render_rgb(second)) for second in seconds]
     exact = world.source.render_depth(view)
     rays = pixel_rays(camera.K, camera.width, camera.height)
     points = (rays * exact[..., None]) @ pose[:3, :3].T + pose[:3, 3]
     inside = (exact > 0) & np.all((points >= lower - 1e-3) & (points <= upper + 1e-3), axis=-1)
     scores = {}
     for name, config in configs.items():
-        depths = []
-        for other, partner in zip(others, partners, strict=True):
-            ranges = [box_depth_range(lower, upper, p) for p in (pose, other)]
-            near, far = min(r[0] for r in ranges), max(r[1] for r in ranges)
-            depths.append(two_view_depth(image, partner, camera.K, pose, other, near, far, config)[0])
+        depths = [box_stereo_depth(image, partner, camera.K, pose, other, lower, upper, config)[0]
+                  for other, partner in zip(others, partners, strict=True)]
         if agree:
             depths = [agreed_depth(depths, config.consistency, agree)]
         kept, errors = np.zeros_like(inside), []

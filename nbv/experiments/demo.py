@@ -51,11 +51,13 @@ from render.dataset import ViewDataset, read_dataset
 from scenes.catalog import DEFAULT_SCENE
 from scenes.model import Scene
 
+ONLINE_PLANNERS = ("random", *tuned_planners(), *depth_planners(), *image_planners())
+"""What the online half flies beside the policy at its count: random views, the registry's tuned orbits,
+depth options and image-only look-ahead."""
 OUTPUTS = ("refined", "recon_full", "recon_refined", "contact_sheet.png", "trajectory_full.png",
            "trajectory_refined.png", "heatmap_refined_vs_full.png", "heatmap_refined_vs_full.ply",
            "heatmap_full_vs_gt.png", "heatmap_full_vs_gt.ply", "results.json", "results.md", "online_policy",
-           "online_random",
-           *(f"online_{name}" for name in (*tuned_planners(), *depth_planners(), *image_planners())),
+           *(f"online_{name}" for name in ONLINE_PLANNERS),
            "sfm_full", "sfm_refined", "refined_linked", "sfm_refined_linked")
 """What one demo run writes into `--out`, all together (the cached `full_scan/` beside them is kept)."""
 
@@ -203,7 +205,7 @@ def online_half(config: DemoConfig, folder: Path) -> dict[str, dict[str, Any]]:
     policy = run_study(online_study(config, folder, "policy", config.policy, None))[0].plan()
     keep = ("views", "planning_s", "gt", "flight_m", "azimuth_reversals", *(("sfm",) if config.sfm else ()))
     runs = {"policy": policy}
-    for name in ("random", *tuned_planners(), *depth_planners(), *image_planners()):
+    for name in ONLINE_PLANNERS:
         runs[name] = run_study(online_study(config, folder, name, name, policy["views"]))[0].plan()
     return {name: {k: plan[k] for k in keep} for name, plan in runs.items()}
 

@@ -44,7 +44,7 @@ from nbv.planning.base import Planner
 from nbv.planning.infogain import target_grid
 from nbv.recon.config import OccupancyConfig
 from nbv.recon.occupancy import UNKNOWN, OccupancyGrid
-from nbv.recon.stereo import StereoConfig, agreed_depth, box_depth_range, grayscale, two_view_depth
+from nbv.recon.stereo import StereoConfig, agreed_depth, box_stereo_depth, grayscale
 from nbv.rl.env import action_to_viewpoint
 from nbv.rl.expert import CANDIDATES, best_action, expert_scores
 from nbv.rl.presets import ORBIT_STEP
@@ -160,21 +160,13 @@ class LookaheadPlanner(Planner):
         for side in self.partners:
             partner = stereo_partner(view, side=side)
             other = viewpoint_to_c2w(partner, center)
-            fused.extend(stereo_depth(image, frame(partner), camera.K, pose, other, grid))
+            fused.extend(box_stereo_depth(image, frame(partner), camera.K, pose, other, grid.lower,
+                                          grid.upper))
             views.extend((pose, other))
         if self.agree:
             fused, views = [agreed_depth(fused[::2], StereoConfig().consistency, self.agree)], [pose]
         for depth, at in zip(fused, views, strict=True):
             grid.integrate(depth, camera.K, at, stride)
-
-
-def stereo_depth(image: np.ndarray, other: np.ndarray, K: np.ndarray, pose: np.ndarray,  # noqa: N803
-                 other_pose: np.ndarray, grid: OccupancyGrid) -> tuple[np.ndarray, np.ndarray]:
-    """Both frames' stereo depth (NaN where not measured), swept between the grid box's nearest and farthest
-    depths from either frame."""
-    ranges = [box_depth_range(grid.lower, grid.upper, p) for p in (pose, other_pose)]
-    near, far = min(r[0] for r in ranges), max(r[1] for r in ranges)
-    return two_view_depth(image, other, K, pose, other_pose, near, far, StereoConfig())
 
 
 def stereo_partner(view: Viewpoint, baseline: float = STEREO_BASELINE_M, side: str = "back") -> Viewpoint:

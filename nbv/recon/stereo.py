@@ -168,6 +168,16 @@ def two_view_depth(ref: np.ndarray, src: np.ndarray, K: np.ndarray, ref_c2w: np.
     return np.where(keep_first, first, np.nan), np.where(keep_second, second, np.nan)
 
 
+def box_stereo_depth(ref: np.ndarray, src: np.ndarray, K: np.ndarray, ref_c2w: np.ndarray,  # noqa: N803
+                     src_c2w: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+                     config: StereoConfig = StereoConfig()) -> tuple[np.ndarray, np.ndarray]:
+    """`two_view_depth` swept between the nearest and farthest depths of the box `lower`-`upper` from either
+    view (the surfaces a target's box can hold)."""
+    ranges = [box_depth_range(lower, upper, pose) for pose in (ref_c2w, src_c2w)]
+    near, far = min(r[0] for r in ranges), max(r[1] for r in ranges)
+    return two_view_depth(ref, src, K, ref_c2w, src_c2w, near, far, config)
+
+
 def agreed_depth(depths: list[np.ndarray], tolerance: float, least: int = 2) -> np.ndarray:
     """One view's depth from several pairs' (each (H, W), NaN where that pair measured nothing): per pixel,
     the mean of the largest group of pairs within a relative `tolerance` of one of them, kept where that

@@ -7,7 +7,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from nbv.recon.stereo import StereoConfig, agreed_depth, box_depth_range, grayscale, sweep, two_view_depth
+from nbv.recon.stereo import (
+    StereoConfig,
+    agreed_depth,
+    box_depth_range,
+    box_stereo_depth,
+    grayscale,
+    sweep,
+    two_view_depth,
+)
 from render.camera import UAVCamera, pixel_rays
 
 CAMERA = UAVCamera(160, 120)
@@ -101,3 +109,14 @@ def test_pairs_agree_on_a_depth_by_majority_and_a_lone_match_is_dropped():
     np.testing.assert_allclose(agreed, [[(2.0 + 2.02 + 1.99) / 3, n, n, (3.0 + 3.01) / 2, n]], rtol=1e-6)
     alone = agreed_depth([first, second, third], 0.02, least=1)
     np.testing.assert_allclose(alone, [[(2.0 + 2.02 + 1.99) / 3, 2.0, 4.0, (3.0 + 3.01) / 2, 1.0]], rtol=1e-6)
+
+
+def test_the_box_sweep_is_the_sweep_between_the_box_depths_from_either_view():
+    left, right = image([(2.0, 0.0)], 0.0)[0], image([(2.0, 0.0)], BASELINE)[0]
+    lower, upper = np.array([-2.0, -2.0, 1.5]), np.array([2.0, 2.0, 3.0])
+    near = min(box_depth_range(lower, upper, p)[0] for p in (pose(0.0), pose(BASELINE)))
+    far = max(box_depth_range(lower, upper, p)[1] for p in (pose(0.0), pose(BASELINE)))
+    boxed = box_stereo_depth(left, right, CAMERA.K, pose(0.0), pose(BASELINE), lower, upper)
+    swept = two_view_depth(left, right, CAMERA.K, pose(0.0), pose(BASELINE), near, far)
+    for a, b in zip(boxed, swept, strict=True):
+        np.testing.assert_array_equal(a, b)

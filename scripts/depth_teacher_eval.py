@@ -10,7 +10,8 @@ round 23 chose `lookahead`'s setting with it. With `--stereo`, each weight is al
 plane-sweep stereo finds between two frames a view (`lookahead-stereo`, name ending _stereo), and again with
 every frame blank (round 25); `--partners back up` takes its second frames on those sides and `--agree N`
 fuses only depths N pairs agree on, `--votes` weighs the grid's hits against passes (round 26; name ending
-_stereo_back-up, _stereo_back-up_a2, _stereo_v).
+_stereo_back-up, _stereo_back-up_a2, _stereo_v); `--frontier K` counts only each ray's first K unknown
+voxels (round 27; name ending _fK).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -48,6 +49,8 @@ def main() -> None:
                         help="with --stereo, fuse only the depths this many pairs agree on (0: every pair's)")
     parser.add_argument("--votes", action="store_true",
                         help="with --stereo, the grid weighs hits against passes, one vote an image")
+    parser.add_argument("--frontier", type=int, default=0,
+                        help="a view sees only each ray's first this many unknown voxels (0: all of them)")
     looks_eval.study_arguments(parser)
     args = parser.parse_args()
     looks_eval.refuse_held_out(args.scenes)
@@ -57,17 +60,20 @@ def main() -> None:
     names, blanks = [], {}
     partners = tuple(args.partners)
     suffix = "_stereo" + ("" if partners == STEREO_PARTNERS else "_" + "-".join(partners)) \
-        + (f"_a{args.agree}" if args.agree else "") + ("_v" if args.votes else "")
+        + (f"_a{args.agree}" if args.agree else "") + ("_v" if args.votes else "") \
+        + (f"_f{args.frontier}" if args.frontier else "")
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"
         for distinct in () if args.no_camera else (False, True) if args.distinct else (False,):
-            planner = LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays, distinct=distinct)
-            planners[name + "_d" * distinct] = (planner, False)
-            names.append(name + "_d" * distinct)
+            planner = LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays, distinct=distinct,
+                                       frontier=args.frontier)
+            camera = name + "_d" * distinct + (f"_f{args.frontier}" if args.frontier else "")
+            planners[camera] = (planner, False)
+            names.append(camera)
         if args.stereo:
             stereo = {blank: LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays, depth="stereo",
                                               blank_images=blank, partners=partners, agree=args.agree,
-                                              votes=args.votes)
+                                              votes=args.votes, frontier=args.frontier)
                       for blank in (False, True)}
             planners[name + suffix], blanks[name + suffix] = (stereo[False], False), stereo[True]
             names.append(name + suffix)

@@ -87,23 +87,25 @@ class LookaheadPlanner(Planner):
                  rays: int = LOOKAHEAD_RAYS, default_views: int = 13, distinct: bool = False,
                  depth: str = "camera", blank_images: bool = False,
                  partners: tuple[str, ...] = STEREO_PARTNERS, agree: int = STEREO_AGREE,
-                 votes: bool = False) -> None:
+                 votes: bool = False, frontier: int = 0) -> None:
         """The flight weight a metre, the grid's voxels along its longest side, the rays across the image;
         `distinct`: never step onto a view already flown (else staying put may win where the flight costs
         more than the grid says is left); `depth`: one of `DEPTH_SOURCES`; `blank_images`: with stereo,
         every captured frame replaced by a blank one (the evaluation's test that it looks); `partners`: with
         stereo, the sides of the view its second frames are taken on (`PARTNER_SIDES`), each swept with it;
         `agree`: 0 fuses every pair's depth of both its frames, N >= 1 only the view's depth that N pairs
-        agree on (`agreed_depth`); `votes`: the grid weighs hits against passes (`OccupancyConfig.votes`)."""
-        if not 0 <= flight < float("inf") or grid < 1 or rays < 1 or depth not in DEPTH_SOURCES:
-            raise ValueError(f"lookahead needs a finite flight weight >= 0, grid >= 1, rays >= 1 and depth "
-                             f"from {DEPTH_SOURCES}, got {flight}, {grid}, {rays}, {depth!r}")
+        agree on (`agreed_depth`); `votes`: the grid weighs hits against passes (`OccupancyConfig.votes`);
+        `frontier` k > 0: a view sees only each ray's first k unknown voxels (`OccupancyGrid.reached`)."""
+        if not 0 <= flight < float("inf") or min(grid, rays, frontier + 1) < 1 or depth not in DEPTH_SOURCES:
+            raise ValueError(f"lookahead needs a finite flight weight >= 0, grid >= 1, rays >= 1, frontier "
+                             f">= 0 and depth from {DEPTH_SOURCES}, got {flight}, {grid}, {rays}, "
+                             f"{frontier}, {depth!r}")
         if not partners or not set(partners) <= set(PARTNER_SIDES) or not 0 <= agree <= len(partners):
             raise ValueError(f"lookahead-stereo's partners are sides from {PARTNER_SIDES} and agree 0 to "
                              f"their number, got {partners}, {agree}")
         self.flight, self.grid, self.rays, self.default_views = flight, grid, rays, default_views
         self.distinct, self.depth, self.blank_images = distinct, depth, blank_images
-        self.partners, self.agree, self.votes = partners, agree, votes
+        self.partners, self.agree, self.votes, self.frontier = partners, agree, votes, frontier
         if depth == "stereo":
             self.name = "lookahead-stereo"
 
@@ -121,7 +123,7 @@ class LookaheadPlanner(Planner):
             key = (round(view.radius, 9), round(view.azimuth % (2 * np.pi), 9), round(view.elevation, 9))
             if key not in seen:
                 seen[key] = grid.reached(camera.K, viewpoint_to_c2w(view, center), camera.width,
-                                         camera.height, stride)
+                                         camera.height, stride, self.frontier)
             return seen[key]
 
         def step(action: np.ndarray, view: Viewpoint) -> Viewpoint:

@@ -21,6 +21,11 @@ probabilistic:
   each ray stopping at the first occupied voxel: the "unobserved voxel" gain of
   both papers with a hard visibility (free and unknown voxels let the ray on,
   occupied ones stop it), computed by ray casting the grid, rendering nothing.
+  With `first` = k, a ray counts only the first k unknown voxels it reaches: at
+  k = 1, the unknown voxels a view would see were unknown space opaque, i.e. where
+  its rays would meet new surface (the "rear side" of unknown space counts once a
+  ray, not once a voxel of its depth; Delmerico et al.'s occlusion-aware gain
+  with visibility 1 for the first k unknown voxels and 0 behind).
 
 Depth is z-depth (docs/conventions.md, `render.renderer`): a pixel's ray has
 direction (x, y, 1) in the camera frame (`render.camera.pixel_rays`), so its hit
@@ -112,14 +117,18 @@ class OccupancyGrid:
         flat[touched] = np.where(self.hits[touched] >= self.passes[touched], OCCUPIED, FREE)
 
     def gain(self, K: np.ndarray, c2w: np.ndarray, width: int, height: int,  # noqa: N803
-             stride: int = 1) -> int:
-        """Distinct unknown voxels that every `stride`-th pixel's ray reaches before an occupied voxel."""
-        return int(self.reached(K, c2w, width, height, stride).sum())
+             stride: int = 1, first: int = 0) -> int:
+        """Distinct unknown voxels that every `stride`-th pixel's ray reaches before an occupied voxel (with
+        `first` > 0, only each ray's first that many)."""
+        return int(self.reached(K, c2w, width, height, stride, first).sum())
 
     def reached(self, K: np.ndarray, c2w: np.ndarray, width: int, height: int,  # noqa: N803
-                stride: int = 1) -> np.ndarray:
+                stride: int = 1, first: int = 0) -> np.ndarray:
         """Which voxels (flat bool, the grid's size) are unknown and reached by every `stride`-th pixel's ray
-        before an occupied voxel: the voxels `gain` counts."""
+        before an occupied voxel, with `first` > 0 only among the first that many unknown voxels of each
+        ray: the voxels `gain` counts."""
+        if first < 0:
+            raise ValueError(f"a ray's first unknown voxels to count must be >= 0 (0: all), got {first}")
         origin, rays = self._rays(K, c2w, width, height, stride)
         rays = rays.reshape(-1, 3)
         flat = self.state.reshape(-1)
@@ -128,7 +137,11 @@ class OccupancyGrid:
                                        np.full(len(rays), np.inf)):
             state = flat[index]
             blocked = np.logical_or.accumulate(valid & (state == OCCUPIED), axis=1)
-            reached[index[valid & ~blocked & (state == UNKNOWN)]] = True
+            unknown = valid & ~blocked & (state == UNKNOWN)
+            if first:  # a sample starts a voxel where its index differs from the sample before it
+                entered = unknown & np.diff(index, axis=1, prepend=-1).astype(bool)
+                unknown &= np.cumsum(entered, axis=1) <= first
+            reached[index[unknown]] = True
         return reached
 
     def contains(self, points: np.ndarray) -> np.ndarray:

@@ -83,6 +83,8 @@ def test_the_spec_sets_the_flight_weight_and_refuses_bad_ones():
         lookahead_planner(PlanSettings(), 0, "fast")
     with pytest.raises(ValueError, match="finite flight weight >= 0"):
         lookahead_planner(PlanSettings(), 0, "-1")
+    with pytest.raises(ValueError, match="frontier >= 0 .* got 0.07, 48, 40, -1"):
+        LookaheadPlanner(frontier=-1)
 
 
 def test_the_second_frame_is_the_baseline_back_along_the_orbit():

@@ -81,6 +81,18 @@ def test_reached_names_the_voxels_gain_counts():
     assert grid.reached(ONE_PIXEL, AGAINST_X, 1, 1).tolist() == [False, False, False, True]  # voxel 3 only
 
 
+def test_first_counts_only_each_rays_first_unknown_voxels():
+    grid = row_of_four()
+    assert grid.reached(ONE_PIXEL, ALONG_X, 1, 1, first=1).tolist() == [True, False, False, False]
+    assert grid.gain(ONE_PIXEL, AGAINST_X, 1, 1, first=2) == 2  # voxels 3 and 2, from the far side
+    grid.integrate(np.array([[0.0]], np.float32), ONE_PIXEL, ALONG_X)  # no hit: the row is free
+    grid.state[2] = UNKNOWN
+    assert grid.reached(ONE_PIXEL, ALONG_X, 1, 1, first=1).tolist() == [False, False, True, False]
+    assert grid.gain(ONE_PIXEL, ALONG_X, 1, 1, first=0) == 1  # free voxels let the ray on and count nothing
+    with pytest.raises(ValueError, match="first unknown voxels to count must be >= 0"):
+        grid.reached(ONE_PIXEL, ALONG_X, 1, 1, first=-1)
+
+
 def test_a_ray_that_misses_the_grid_gains_nothing_and_changes_nothing():
     grid = row_of_four()
     away = AGAINST_X.copy()

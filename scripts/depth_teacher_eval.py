@@ -11,7 +11,8 @@ plane-sweep stereo finds between two frames a view (`lookahead-stereo`, name end
 every frame blank (round 25); `--partners back up` takes its second frames on those sides and `--agree N`
 fuses only depths N pairs agree on, `--votes` weighs the grid's hits against passes (round 26; name ending
 _stereo_back-up, _stereo_back-up_a2, _stereo_v); `--frontier K` counts only each ray's first K unknown
-voxels (round 27; name ending _fK).
+voxels (round 27; name ending _fK); `--distinct` flies each look-ahead again never stepping onto a view
+already flown (rounds 24 and 27; name ending _d).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -38,7 +39,8 @@ def main() -> None:
     parser.add_argument("--grid-resolution", type=int, default=32, help="voxels along the longest side")
     parser.add_argument("--gain-ray-stride", type=int, default=8, help="every n-th pixel's ray, both axes")
     parser.add_argument("--distinct", action="store_true",
-                        help="also fly each weight never stepping onto a view already flown (name ending _d)")
+                        help="also fly each weight (camera, stereo) never stepping onto a view already "
+                             "flown (name ending _d)")
     parser.add_argument("--stereo", action="store_true",
                         help="also fly each weight on stereo depth from the images (name ending _stereo)")
     parser.add_argument("--no-camera", action="store_true",
@@ -51,6 +53,10 @@ def main() -> None:
                         help="with --stereo, the grid weighs hits against passes, one vote an image")
     parser.add_argument("--frontier", type=int, default=0,
                         help="a view sees only each ray's first this many unknown voxels (0: all of them)")
+    parser.add_argument("--allowance", type=float, default=0.0,
+                        help="metres of the flight before --excess a metre more is charged")
+    parser.add_argument("--excess", type=float, default=0.0,
+                        help="coverage points a metre charged past --allowance (0: no hinge)")
     looks_eval.study_arguments(parser)
     args = parser.parse_args()
     looks_eval.refuse_held_out(args.scenes)
@@ -59,24 +65,27 @@ def main() -> None:
     planners = {name: (make_planner(name, PlanSettings()), False) for name in ("orbit", "orbit2", "random")}
     names, blanks = [], {}
     partners = tuple(args.partners)
+    options = (f"_f{args.frontier}" if args.frontier else "") \
+        + (f"_h{args.allowance:g}x{args.excess:g}" if args.excess else "")
     suffix = "_stereo" + ("" if partners == STEREO_PARTNERS else "_" + "-".join(partners)) \
-        + (f"_a{args.agree}" if args.agree else "") + ("_v" if args.votes else "") \
-        + (f"_f{args.frontier}" if args.frontier else "")
+        + (f"_a{args.agree}" if args.agree else "") + ("_v" if args.votes else "") + options
+    common = {"grid": args.grid_resolution, "rays": rays, "frontier": args.frontier,
+              "allowance_m": args.allowance, "excess": args.excess}
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"
-        for distinct in () if args.no_camera else (False, True) if args.distinct else (False,):
-            planner = LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays, distinct=distinct,
-                                       frontier=args.frontier)
-            camera = name + "_d" * distinct + (f"_f{args.frontier}" if args.frontier else "")
-            planners[camera] = (planner, False)
-            names.append(camera)
-        if args.stereo:
-            stereo = {blank: LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays, depth="stereo",
-                                              blank_images=blank, partners=partners, agree=args.agree,
-                                              votes=args.votes, frontier=args.frontier)
-                      for blank in (False, True)}
-            planners[name + suffix], blanks[name + suffix] = (stereo[False], False), stereo[True]
-            names.append(name + suffix)
+        for distinct in (False, True) if args.distinct else (False,):
+            if not args.no_camera:
+                camera = name + "_d" * distinct + options
+                planners[camera] = (LookaheadPlanner(flight=w, distinct=distinct, **common), False)
+                names.append(camera)
+            if args.stereo:
+                stereo = {blank: LookaheadPlanner(flight=w, distinct=distinct, depth="stereo",
+                                                  blank_images=blank, partners=partners, agree=args.agree,
+                                                  votes=args.votes, **common)
+                          for blank in (False, True)}
+                flown = name + suffix + "_d" * distinct
+                planners[flown], blanks[flown] = (stereo[False], False), stereo[True]
+                names.append(flown)
     results = looks_eval.evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work,
                                   blanks=blanks)
     checks = looks_eval.policy_acceptance(results, args.scenes, names)

@@ -87,7 +87,8 @@ class LookaheadPlanner(Planner):
                  rays: int = LOOKAHEAD_RAYS, default_views: int = 13, distinct: bool = False,
                  depth: str = "camera", blank_images: bool = False,
                  partners: tuple[str, ...] = STEREO_PARTNERS, agree: int = STEREO_AGREE,
-                 votes: bool = False, frontier: int = 0) -> None:
+                 votes: bool = False, frontier: int = 0, allowance_m: float = 0.0,
+                 excess: float = 0.0) -> None:
         """The flight weight a metre, the grid's voxels along its longest side, the rays across the image;
         `distinct`: never step onto a view already flown (else staying put may win where the flight costs
         more than the grid says is left); `depth`: one of `DEPTH_SOURCES`; `blank_images`: with stereo,
@@ -95,17 +96,23 @@ class LookaheadPlanner(Planner):
         stereo, the sides of the view its second frames are taken on (`PARTNER_SIDES`), each swept with it;
         `agree`: 0 fuses every pair's depth of both its frames, N >= 1 only the view's depth that N pairs
         agree on (`agreed_depth`); `votes`: the grid weighs hits against passes (`OccupancyConfig.votes`);
-        `frontier` k > 0: a view sees only each ray's first k unknown voxels (`OccupancyGrid.reached`)."""
+        `frontier` k > 0: a view sees only each ray's first k unknown voxels (`OccupancyGrid.reached`);
+        `excess`: coverage points a metre more for the flight past `allowance_m` metres (a battery's budget,
+        as the teacher's hinge, `nbv.rl.flight_cost`)."""
         if not 0 <= flight < float("inf") or min(grid, rays, frontier + 1) < 1 or depth not in DEPTH_SOURCES:
             raise ValueError(f"lookahead needs a finite flight weight >= 0, grid >= 1, rays >= 1, frontier "
                              f">= 0 and depth from {DEPTH_SOURCES}, got {flight}, {grid}, {rays}, "
                              f"{frontier}, {depth!r}")
+        if not (0 <= allowance_m < float("inf") and 0 <= excess < float("inf")):
+            raise ValueError(f"lookahead's flight allowance and excess weight are finite and >= 0, got "
+                             f"{allowance_m}, {excess}")
         if not partners or not set(partners) <= set(PARTNER_SIDES) or not 0 <= agree <= len(partners):
             raise ValueError(f"lookahead-stereo's partners are sides from {PARTNER_SIDES} and agree 0 to "
                              f"their number, got {partners}, {agree}")
         self.flight, self.grid, self.rays, self.default_views = flight, grid, rays, default_views
         self.distinct, self.depth, self.blank_images = distinct, depth, blank_images
         self.partners, self.agree, self.votes, self.frontier = partners, agree, votes, frontier
+        self.allowance_m, self.excess = allowance_m, excess
         if depth == "stereo":
             self.name = "lookahead-stereo"
 
@@ -135,7 +142,8 @@ class LookaheadPlanner(Planner):
             seen.clear()
             known = grid.state.reshape(-1) != UNKNOWN
             scores = expert_scores(view, known, sees, step, self.flight, left, HORIZON, DISCOUNT,
-                                   flown_m=shell_path(chosen[0], chosen[1:]).total_m)
+                                   flown_m=shell_path(chosen[0], chosen[1:]).total_m,
+                                   allowance_m=self.allowance_m, excess_weight=self.excess)
             if self.distinct:
                 repeats = np.array([revisits(step(action, view), chosen) for action in CANDIDATES])
                 scores = np.where(repeats, -np.inf, scores) if not repeats.all() else scores

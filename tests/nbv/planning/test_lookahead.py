@@ -58,6 +58,18 @@ def test_a_dear_flight_takes_the_shortest_leg():
     assert shell_path(world.start, views[1:]).total_m == min(legs)
 
 
+def test_past_its_allowance_a_hinged_flight_takes_the_shortest_leg_and_free_before_it_turns():
+    env = config()
+    world = PlanningWorld(env, seed=3)
+    free = LookaheadPlanner(flight=0.0, grid=16, rays=8).plan(world, 3)
+    assert LookaheadPlanner(flight=0.0, grid=16, rays=8, allowance_m=1e3, excess=1e5).plan(world, 3) == free
+    views = LookaheadPlanner(flight=0.0, grid=16, rays=8, allowance_m=0.0, excess=1e5).plan(world, 2)
+    legs = [shell_path(world.start, [s]).total_m for s in steps_from(world.start, env)]
+    assert shell_path(world.start, views[1:]).total_m == min(legs)
+    with pytest.raises(ValueError, match="allowance and excess weight are finite and >= 0, got 1.0, -2"):
+        LookaheadPlanner(allowance_m=1.0, excess=-2)
+
+
 def test_a_distinct_flight_never_repeats_a_view_where_staying_put_costs_least():
     world = PlanningWorld(config(), seed=3)
     stays = LookaheadPlanner(flight=1e5, grid=16, rays=8).plan(world, 4)

@@ -10,9 +10,10 @@ round 23 chose `lookahead`'s setting with it. With `--stereo`, each weight is al
 plane-sweep stereo finds between two frames a view (`lookahead-stereo`, name ending _stereo), and again with
 every frame blank (round 25); `--partners back up` takes its second frames on those sides and `--agree N`
 fuses only depths N pairs agree on, `--votes` weighs the grid's hits against passes (round 26; name ending
-_stereo_back-up, _stereo_back-up_a2, _stereo_v); `--frontier K` counts only each ray's first K unknown
-voxels (round 27; name ending _fK); `--distinct` flies each look-ahead again never stepping onto a view
-already flown (rounds 24 and 27; name ending _d).
+_stereo_back-up, _stereo_back-up_a2, _stereo_v). Round 27: `--frontier K` counts only each ray's first K
+unknown voxels (name ending _fK), `--allowance M --excess W` charges W a metre more past M metres (_hMxW),
+`--patience N` gives up on unknown voxels N views reached without measuring (_pN); `--distinct` flies each
+look-ahead again never stepping onto a view already flown (rounds 24 and 27; name ending _d).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -33,7 +34,8 @@ sys.path.insert(0, str(Path(__file__).parent))
 import looks_eval  # noqa: E402
 
 
-def main() -> None:
+def arguments() -> argparse.Namespace:
+    """The command line: the look-ahead's settings, then the study's (`looks_eval.study_arguments`)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--flight-reward", type=float, nargs="+", default=[0.05])
     parser.add_argument("--grid-resolution", type=int, default=32, help="voxels along the longest side")
@@ -57,8 +59,14 @@ def main() -> None:
                         help="metres of the flight before --excess a metre more is charged")
     parser.add_argument("--excess", type=float, default=0.0,
                         help="coverage points a metre charged past --allowance (0: no hinge)")
+    parser.add_argument("--patience", type=int, default=0,
+                        help="an unknown voxel that many views flown reached unmeasured counts as seen")
     looks_eval.study_arguments(parser)
-    args = parser.parse_args()
+    return parser.parse_args()
+
+
+def main() -> None:
+    args = arguments()
     looks_eval.refuse_held_out(args.scenes)
     trained = default_preset().env
     rays = max(1, trained.camera.width // args.gain_ray_stride)
@@ -66,11 +74,12 @@ def main() -> None:
     names, blanks = [], {}
     partners = tuple(args.partners)
     options = (f"_f{args.frontier}" if args.frontier else "") \
-        + (f"_h{args.allowance:g}x{args.excess:g}" if args.excess else "")
+        + (f"_h{args.allowance:g}x{args.excess:g}" if args.excess else "") \
+        + (f"_p{args.patience}" if args.patience else "")
     suffix = "_stereo" + ("" if partners == STEREO_PARTNERS else "_" + "-".join(partners)) \
         + (f"_a{args.agree}" if args.agree else "") + ("_v" if args.votes else "") + options
     common = {"grid": args.grid_resolution, "rays": rays, "frontier": args.frontier,
-              "allowance_m": args.allowance, "excess": args.excess}
+              "allowance_m": args.allowance, "excess": args.excess, "patience": args.patience}
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"
         for distinct in (False, True) if args.distinct else (False,):

@@ -70,6 +70,25 @@ def test_past_its_allowance_a_hinged_flight_takes_the_shortest_leg_and_free_befo
         LookaheadPlanner(allowance_m=1.0, excess=-2)
 
 
+def test_with_patience_it_gives_up_on_what_it_looked_at_without_measuring():
+    world = PlanningWorld(config(), seed=3)  # blank frames: stereo measures nothing, the grid stays unknown
+    grid = target_grid(world.target, OccupancyConfig(grid_resolution=16))
+    K, width, height, center = world.camera.K, world.camera.width, world.camera.height, world.target.center()
+
+    def reached(view):
+        return grid.reached(K, viewpoint_to_c2w(view, center), width, height, round(width / 8))
+
+    overlap = {}
+    for patience in (0, 1):
+        planner = LookaheadPlanner(flight=0.0, grid=16, rays=8, depth="stereo", blank_images=True,
+                                   patience=patience)
+        views = planner.plan(world, 2)
+        overlap[patience] = np.count_nonzero(reached(views[1]) & reached(world.start))
+    assert overlap[1] < overlap[0]  # it turns from what the start view looked at
+    with pytest.raises(ValueError, match="patience is a count of views >= 0 .* got -1"):
+        LookaheadPlanner(patience=-1)
+
+
 def test_a_distinct_flight_never_repeats_a_view_where_staying_put_costs_least():
     world = PlanningWorld(config(), seed=3)
     stays = LookaheadPlanner(flight=1e5, grid=16, rays=8).plan(world, 4)

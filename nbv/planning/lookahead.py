@@ -29,7 +29,9 @@ Held out, scored once (paper_results/online/stereo): 3.8 points above the ring i
 lost with blank frames, 3.4 under the ring on the walled compound. Round 26 (paper_results/selection/round26)
 tried more second frames (`partners`), fusing only depths pairs agree on (`agree`) and a grid that votes
 hits against passes (`votes`) on the validation buildings: each passes the same four checks, so none is the
-default.
+default. Round 27 (paper_results/selection/round27) tried counting only each ray's first unknown voxels
+(`frontier`), a battery's hinge on the flight (`allowance_m`, `excess`) and giving up on what views flown
+looked at without measuring (`patience`): none passes more, so none is the default either.
 """
 
 from __future__ import annotations

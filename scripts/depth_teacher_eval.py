@@ -12,8 +12,9 @@ every frame blank (round 25); `--partners back up` takes its second frames on th
 fuses only depths N pairs agree on, `--votes` weighs the grid's hits against passes (round 26; name ending
 _stereo_back-up, _stereo_back-up_a2, _stereo_v). Round 27: `--frontier K` counts only each ray's first K
 unknown voxels (name ending _fK), `--allowance M --excess W` charges W a metre more past M metres (_hMxW),
-`--patience N` gives up on unknown voxels N views reached without measuring (_pN); `--distinct` flies each
-look-ahead again never stepping onto a view already flown (rounds 24 and 27; name ending _d).
+`--patience N` gives up on unknown voxels N views reached without measuring (_pN), `--horizon H` scores H
+views ahead (_HH); `--distinct` flies each look-ahead again never stepping onto a view already flown (rounds
+24 and 27; name ending _d).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -26,7 +27,7 @@ from pathlib import Path
 
 from common.io import atomic_folder
 from nbv.planning.config import PlanSettings
-from nbv.planning.lookahead import PARTNER_SIDES, STEREO_PARTNERS, LookaheadPlanner
+from nbv.planning.lookahead import HORIZON, PARTNER_SIDES, STEREO_PARTNERS, LookaheadPlanner
 from nbv.planning.registry import make_planner
 from nbv.rl.presets import default_preset
 
@@ -61,6 +62,7 @@ def arguments() -> argparse.Namespace:
                         help="coverage points a metre charged past --allowance (0: no hinge)")
     parser.add_argument("--patience", type=int, default=0,
                         help="an unknown voxel that many views flown reached unmeasured counts as seen")
+    parser.add_argument("--horizon", type=int, default=HORIZON, help="views scored ahead of each step")
     looks_eval.study_arguments(parser)
     return parser.parse_args()
 
@@ -75,11 +77,13 @@ def main() -> None:
     partners = tuple(args.partners)
     options = (f"_f{args.frontier}" if args.frontier else "") \
         + (f"_h{args.allowance:g}x{args.excess:g}" if args.excess else "") \
-        + (f"_p{args.patience}" if args.patience else "")
+        + (f"_p{args.patience}" if args.patience else "") \
+        + (f"_H{args.horizon}" if args.horizon != HORIZON else "")
     suffix = "_stereo" + ("" if partners == STEREO_PARTNERS else "_" + "-".join(partners)) \
         + (f"_a{args.agree}" if args.agree else "") + ("_v" if args.votes else "") + options
     common = {"grid": args.grid_resolution, "rays": rays, "frontier": args.frontier,
-              "allowance_m": args.allowance, "excess": args.excess, "patience": args.patience}
+              "allowance_m": args.allowance, "excess": args.excess, "patience": args.patience,
+              "horizon": args.horizon}
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"
         for distinct in (False, True) if args.distinct else (False,):

@@ -90,7 +90,7 @@ class LookaheadPlanner(Planner):
                  depth: str = "camera", blank_images: bool = False,
                  partners: tuple[str, ...] = STEREO_PARTNERS, agree: int = STEREO_AGREE,
                  votes: bool = False, frontier: int = 0, allowance_m: float = 0.0,
-                 excess: float = 0.0, patience: int = 0) -> None:
+                 excess: float = 0.0, patience: int = 0, horizon: int = HORIZON) -> None:
         """The flight weight a metre, the grid's voxels along its longest side, the rays across the image;
         `distinct`: never step onto a view already flown (else staying put may win where the flight costs
         more than the grid says is left); `depth`: one of `DEPTH_SOURCES`; `blank_images`: with stereo,
@@ -101,13 +101,15 @@ class LookaheadPlanner(Planner):
         `frontier` k > 0: a view sees only each ray's first k unknown voxels (`OccupancyGrid.reached`);
         `excess`: coverage points a metre more for the flight past `allowance_m` metres (a battery's budget,
         as the teacher's hinge, `nbv.rl.flight_cost`); `patience` n > 0: an unknown voxel that n views flown
-        have reached without measuring it counts as seen (stereo leaves texture it cannot match unknown)."""
+        have reached without measuring it counts as seen (stereo leaves texture it cannot match unknown);
+        `horizon`: the views scored ahead of each candidate step."""
         if not 0 <= flight < float("inf") or min(grid, rays, frontier + 1) < 1 or depth not in DEPTH_SOURCES:
             raise ValueError(f"lookahead needs a finite flight weight >= 0, grid >= 1, rays >= 1, frontier "
                              f">= 0 and depth from {DEPTH_SOURCES}, got {flight}, {grid}, {rays}, "
                              f"{frontier}, {depth!r}")
-        if patience < 0:
-            raise ValueError(f"lookahead's patience is a count of views >= 0 (0: never), got {patience}")
+        if patience < 0 or horizon < 1:
+            raise ValueError(f"lookahead's patience is a count of views >= 0 (0: never) and its horizon "
+                             f">= 1, got {patience}, {horizon}")
         if not (0 <= allowance_m < float("inf") and 0 <= excess < float("inf")):
             raise ValueError(f"lookahead's flight allowance and excess weight are finite and >= 0, got "
                              f"{allowance_m}, {excess}")
@@ -117,7 +119,7 @@ class LookaheadPlanner(Planner):
         self.flight, self.grid, self.rays, self.default_views = flight, grid, rays, default_views
         self.distinct, self.depth, self.blank_images = distinct, depth, blank_images
         self.partners, self.agree, self.votes, self.frontier = partners, agree, votes, frontier
-        self.allowance_m, self.excess, self.patience = allowance_m, excess, patience
+        self.allowance_m, self.excess, self.patience, self.horizon = allowance_m, excess, patience, horizon
         if depth == "stereo":
             self.name = "lookahead-stereo"
 
@@ -150,7 +152,7 @@ class LookaheadPlanner(Planner):
             if self.patience:
                 looked += sees(view)
                 known |= looked >= self.patience
-            scores = expert_scores(view, known, sees, step, self.flight, left, HORIZON, DISCOUNT,
+            scores = expert_scores(view, known, sees, step, self.flight, left, self.horizon, DISCOUNT,
                                    flown_m=shell_path(chosen[0], chosen[1:]).total_m,
                                    allowance_m=self.allowance_m, excess_weight=self.excess)
             if self.distinct:

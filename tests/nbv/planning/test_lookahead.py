@@ -85,8 +85,10 @@ def test_with_patience_it_gives_up_on_what_it_looked_at_without_measuring():
         views = planner.plan(world, 2)
         overlap[patience] = np.count_nonzero(reached(views[1]) & reached(world.start))
     assert overlap[1] < overlap[0]  # it turns from what the start view looked at
-    with pytest.raises(ValueError, match="patience is a count of views >= 0 .* got -1"):
+    with pytest.raises(ValueError, match="patience is a count of views >= 0 .* got -1, 3"):
         LookaheadPlanner(patience=-1)
+    with pytest.raises(ValueError, match="its horizon >= 1, got 0, 0"):
+        LookaheadPlanner(horizon=0)
 
 
 def test_a_distinct_flight_never_repeats_a_view_where_staying_put_costs_least():

@@ -90,7 +90,8 @@ class LookaheadPlanner(Planner):
                  depth: str = "camera", blank_images: bool = False,
                  partners: tuple[str, ...] = STEREO_PARTNERS, agree: int = STEREO_AGREE,
                  votes: bool = False, frontier: int = 0, allowance_m: float = 0.0,
-                 excess: float = 0.0, patience: int = 0, horizon: int = HORIZON) -> None:
+                 excess: float = 0.0, patience: int = 0, horizon: int = HORIZON,
+                 next_to_free: bool = False) -> None:
         """The flight weight a metre, the grid's voxels along its longest side, the rays across the image;
         `distinct`: never step onto a view already flown (else staying put may win where the flight costs
         more than the grid says is left); `depth`: one of `DEPTH_SOURCES`; `blank_images`: with stereo,
@@ -102,7 +103,8 @@ class LookaheadPlanner(Planner):
         `excess`: coverage points a metre more for the flight past `allowance_m` metres (a battery's budget,
         as the teacher's hinge, `nbv.rl.flight_cost`); `patience` n > 0: an unknown voxel that n views flown
         have reached without measuring it counts as seen (stereo leaves texture it cannot match unknown);
-        `horizon`: the views scored ahead of each candidate step."""
+        `horizon`: the views scored ahead of each candidate step; `next_to_free`: a view sees only the
+        unknown voxels it reaches that lie beside free space (`OccupancyGrid.frontier`)."""
         if not 0 <= flight < float("inf") or min(grid, rays, frontier + 1) < 1 or depth not in DEPTH_SOURCES:
             raise ValueError(f"lookahead needs a finite flight weight >= 0, grid >= 1, rays >= 1, frontier "
                              f">= 0 and depth from {DEPTH_SOURCES}, got {flight}, {grid}, {rays}, "
@@ -120,6 +122,7 @@ class LookaheadPlanner(Planner):
         self.distinct, self.depth, self.blank_images = distinct, depth, blank_images
         self.partners, self.agree, self.votes, self.frontier = partners, agree, votes, frontier
         self.allowance_m, self.excess, self.patience, self.horizon = allowance_m, excess, patience, horizon
+        self.next_to_free = next_to_free
         if depth == "stereo":
             self.name = "lookahead-stereo"
 
@@ -138,16 +141,19 @@ class LookaheadPlanner(Planner):
             if key not in seen:
                 seen[key] = grid.reached(camera.K, viewpoint_to_c2w(view, center), camera.width,
                                          camera.height, stride, self.frontier)
+                if self.next_to_free:
+                    seen[key] &= edge
             return seen[key]
 
         def step(action: np.ndarray, view: Viewpoint) -> Viewpoint:
             return action_to_viewpoint(action, view, steps)
 
-        view, chosen = world.start, [world.start]
+        view, chosen, edge = world.start, [world.start], None
         looked = np.zeros(grid.state.size, np.uint16)  # views flown that reached each voxel, still unknown
         for left in range((self.default_views if views is None else views) - 1, 0, -1):
             self.measure(world, grid, view)
             seen.clear()
+            edge = grid.frontier() if self.next_to_free else None
             known = grid.state.reshape(-1) != UNKNOWN
             if self.patience:
                 looked += sees(view)

@@ -144,6 +144,17 @@ class OccupancyGrid:
             reached[index[unknown]] = True
         return reached
 
+    def frontier(self) -> np.ndarray:
+        """Which voxels (flat bool) are unknown with a free face neighbour: the frontier between the space
+        known to be empty and the unknown (Yamauchi, "A frontier-based approach for autonomous exploration",
+        1997), where a surface not yet measured can lie."""
+        free = np.pad(self.state == FREE, 1)
+        beside = np.zeros(self.state.shape, dtype=bool)
+        for axis in range(3):
+            for shift in (-1, 1):
+                beside |= np.roll(free, shift, axis=axis)[1:-1, 1:-1, 1:-1]
+        return ((self.state == UNKNOWN) & beside).reshape(-1)
+
     def contains(self, points: np.ndarray) -> np.ndarray:
         """(N,) True where a point lies inside the grid's box."""
         return np.all((points >= self.lower) & (points < self.upper), axis=-1)

@@ -91,6 +91,16 @@ def test_with_patience_it_gives_up_on_what_it_looked_at_without_measuring():
         LookaheadPlanner(horizon=0)
 
 
+def test_next_to_free_sees_only_the_frontier_so_blank_frames_take_the_shortest_leg():
+    env = config()
+    world = PlanningWorld(env, seed=3)
+    legs = [shell_path(world.start, [s]).total_m for s in steps_from(world.start, env)]
+    blind = LookaheadPlanner(flight=0.0, grid=16, rays=8, depth="stereo", blank_images=True, next_to_free=True)
+    assert shell_path(world.start, blind.plan(world, 2)[1:]).total_m == min(legs)  # nothing free: no gain
+    looking = LookaheadPlanner(flight=0.0, grid=16, rays=8, next_to_free=True).plan(world, 2)
+    assert shell_path(world.start, looking[1:]).total_m > min(legs)
+
+
 def test_a_distinct_flight_never_repeats_a_view_where_staying_put_costs_least():
     world = PlanningWorld(config(), seed=3)
     stays = LookaheadPlanner(flight=1e5, grid=16, rays=8).plan(world, 4)

@@ -93,6 +93,19 @@ def test_first_counts_only_each_rays_first_unknown_voxels():
         grid.reached(ONE_PIXEL, ALONG_X, 1, 1, first=-1)
 
 
+def test_the_frontier_is_the_unknown_beside_free_space():
+    grid = row_of_four()
+    assert not grid.frontier().any()  # nothing known: no frontier
+    grid.integrate(np.array([[1.5]], np.float32), ONE_PIXEL, ALONG_X)  # free, occupied, unknown, unknown
+    assert not grid.frontier().any()  # the unknown lies behind the hit, not beside free space
+    grid.state[:, 0, 0] = [UNKNOWN, FREE, UNKNOWN, OCCUPIED]
+    assert grid.frontier().tolist() == [True, False, True, False]
+    cube = OccupancyGrid(np.zeros(3), np.full(3, 3.0), resolution=3)
+    cube.state[1, 1, 1] = FREE
+    assert cube.frontier().sum() == 6  # its six face neighbours, not the edges or corners
+    assert cube.frontier().reshape(3, 3, 3)[0, 1, 1] and not cube.frontier().reshape(3, 3, 3)[0, 0, 1]
+
+
 def test_a_ray_that_misses_the_grid_gains_nothing_and_changes_nothing():
     grid = row_of_four()
     away = AGAINST_X.copy()

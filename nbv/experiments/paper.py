@@ -357,9 +357,10 @@ INDEX = (
     Result("selection/round26/README.md", "selection/round26/three_frames_votes/results.json", "its "
            "twenty-sixth round: lookahead-stereo with three second frames, two-pair agreement and a voting "
            "occupancy grid (not adopted)", LOOKS_EVAL),
-    Result("selection/round27/README.md", "selection/round27/horizon5/results.json", "its "
-           "twenty-seventh round: lookahead-stereo counting each ray's first unknown voxel, a battery's "
-           "hinge, patience with what stereo cannot measure and a longer horizon (not adopted)", LOOKS_EVAL),
+    Result("selection/round27/README.md", "selection/round27/next_to_free/results.json", "its "
+           "twenty-seventh round: lookahead-stereo counting each ray's first unknown voxel or the unknown "
+           "beside free space, a battery's hinge, patience with what stereo cannot measure and a longer "
+           "horizon (not adopted), and what the courtyard loses", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

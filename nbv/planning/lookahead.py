@@ -30,8 +30,9 @@ lost with blank frames, 3.4 under the ring on the walled compound. Round 26 (pap
 tried more second frames (`partners`), fusing only depths pairs agree on (`agree`) and a grid that votes
 hits against passes (`votes`) on the validation buildings: each passes the same four checks, so none is the
 default. Round 27 (paper_results/selection/round27) tried counting only each ray's first unknown voxels
-(`frontier`), a battery's hinge on the flight (`allowance_m`, `excess`) and giving up on what views flown
-looked at without measuring (`patience`): none passes more, so none is the default either.
+(`frontier`), a battery's hinge on the flight (`allowance_m`, `excess`), giving up on what views flown
+looked at without measuring (`patience`), five views ahead (`horizon`) and counting only the unknown beside
+free space (`next_to_free`): none passes more, so none is the default either.
 """
 
 from __future__ import annotations

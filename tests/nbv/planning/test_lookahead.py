@@ -95,7 +95,8 @@ def test_next_to_free_sees_only_the_frontier_so_blank_frames_take_the_shortest_l
     env = config()
     world = PlanningWorld(env, seed=3)
     legs = [shell_path(world.start, [s]).total_m for s in steps_from(world.start, env)]
-    blind = LookaheadPlanner(flight=0.0, grid=16, rays=8, depth="stereo", blank_images=True, next_to_free=True)
+    blind = LookaheadPlanner(flight=0.0, grid=16, rays=8, depth="stereo", blank_images=True,
+                             next_to_free=True)
     assert shell_path(world.start, blind.plan(world, 2)[1:]).total_m == min(legs)  # nothing free: no gain
     looking = LookaheadPlanner(flight=0.0, grid=16, rays=8, next_to_free=True).plan(world, 2)
     assert shell_path(world.start, looking[1:]).total_m > min(legs)

@@ -26,6 +26,8 @@ probabilistic:
   its rays would meet new surface (the "rear side" of unknown space counts once a
   ray, not once a voxel of its depth; Delmerico et al.'s occlusion-aware gain
   with visibility 1 for the first k unknown voxels and 0 behind).
+- `frontier`: the unknown voxels beside free space (Yamauchi 1997), where a
+  surface not yet measured can lie.
 
 Depth is z-depth (docs/conventions.md, `render.renderer`): a pixel's ray has
 direction (x, y, 1) in the camera frame (`render.camera.pixel_rays`), so its hit

@@ -143,6 +143,11 @@ def summarise(by_scene: dict[str, dict], scenes: list[str], seeds: list[int]) ->
     return summary
 
 
+def work_file(work: Path, name: str, scene: str) -> Path:
+    """Where a study keeps one planner's runs on one building in its work folder."""
+    return work / name / f"{scene.replace(':', '_')}.json"
+
+
 def evaluate(planners: dict[str, tuple[Planner, bool]], trained: EnvConfig, scenes: list[str],
              seeds: list[int], views: int, work: Path, blank_images: bool = True,
              blanks: dict[str, Planner] | None = None) -> dict:
@@ -160,7 +165,7 @@ def evaluate(planners: dict[str, tuple[Planner, bool]], trained: EnvConfig, scen
         blank = blank if blank_images else None
         by_scene = {}
         for scene in scenes:
-            saved = work / name / f"{scene.replace(':', '_')}.json"
+            saved = work_file(work, name, scene)
             doc = json.loads(saved.read_text()) if saved.is_file() else None
             if doc is not None and doc["key"] == key and (blank is None or doc["result"]["blank"]):
                 by_scene[scene] = doc["result"]

@@ -17,22 +17,23 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
-import trimesh
 from matplotlib.figure import Figure
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import git_commit, portable_record
-from nbv.planning.world import PlanningWorld
 from nbv.recon.visibility import scene_visibility
 from nbv.rl.presets import default_preset
 from nbv.rl.validate import evaluation_env_config
 from nbv.viz.figures import save_figure
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
-from scenes.family_splits import held_out
 from scenes.spec import SceneSet
+
+sys.path.insert(0, str(Path(__file__).parent))
+import looks_eval  # noqa: E402
 
 KINDS = ("roof", "outer wall", "inner wall", "other")
 """How a surface sample faces, in `facing`'s order."""
@@ -66,20 +67,16 @@ def compare(scene: str, flights: dict[str, dict], seeds: list[int], picture: Pat
     """Per start view, the two flights' coverage and the samples one sees and the other misses
     (`flights`: {"planner": runs, "baseline": runs}, runs by seed as a work folder keeps them)."""
     config = evaluation_env_config(default_preset().env, SceneSet(scene=(scene,)))
-    target = PlanningWorld(config, seed=seeds[0]).target
-    mesh, center = target.target_mesh(), target.center()
+    target = config.scenes.specs()[0].load()
+    normals, center = target.target_mesh().face_normals, target.center()
     rows = []
     for seed in seeds:
         visibility = scene_visibility(target, config.camera, seed=seed)
-        points, faces = trimesh.sample.sample_surface(mesh, len(visibility.samples), seed=seed)
-        if not np.allclose(points, visibility.samples):
-            raise RuntimeError("the samples drawn again differ from the visibility's (trimesh's sampling)")
-        kinds = facing(points, mesh.face_normals[faces], center)
-        seen = {}
-        for role, runs in flights.items():
-            seen[role] = np.zeros(len(points), dtype=bool)
-            for view in runs[str(seed)]["viewpoints"]:
-                seen[role] |= visibility.seen(viewpoint_to_c2w(Viewpoint(*view), center))
+        points = visibility.samples
+        kinds = facing(points, normals[visibility.faces], center)
+        seen = {role: visibility.seen_by([viewpoint_to_c2w(Viewpoint(*view), center)
+                                          for view in runs[str(seed)]["viewpoints"]])
+                for role, runs in flights.items()}
         missed, alone = seen["baseline"] & ~seen["planner"], seen["planner"] & ~seen["baseline"]
         rows.append({"seed": seed, "coverage": {r: 100.0 * float(s.mean()) for r, s in seen.items()},
                      "missed": describe(missed, kinds, points, center),
@@ -130,11 +127,10 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4, 5])
     parser.add_argument("--out", type=Path, required=True)
     args = parser.parse_args()
-    if held_out(args.scene):
-        raise SystemExit(f"held-out buildings are not for choosing: {args.scene}; give a validation one")
+    looks_eval.refuse_held_out([args.scene])
     flights = {}
     for role, name in (("planner", args.planner), ("baseline", args.baseline)):
-        saved = args.work / name / f"{args.scene.replace(':', '_')}.json"
+        saved = looks_eval.work_file(args.work, name, args.scene)
         if not saved.is_file():
             raise SystemExit(f"no flights of {name} on {args.scene} in {args.work} ({saved.name} missing)")
         flights[role] = json.loads(saved.read_text())["result"]["runs"]

@@ -150,11 +150,12 @@ class OccupancyGrid:
         """Which voxels (flat bool) are unknown with a free face neighbour: the frontier between the space
         known to be empty and the unknown (Yamauchi, "A frontier-based approach for autonomous exploration",
         1997), where a surface not yet measured can lie."""
-        free = np.pad(self.state == FREE, 1)
+        free = np.pad(self.state == FREE, 1)  # a border of non-free voxels: every neighbour is a slice
+        inner = slice(1, -1)
         beside = np.zeros(self.state.shape, dtype=bool)
         for axis in range(3):
-            for shift in (-1, 1):
-                beside |= np.roll(free, shift, axis=axis)[1:-1, 1:-1, 1:-1]
+            for near in (slice(None, -2), slice(2, None)):
+                beside |= free[tuple(near if a == axis else inner for a in range(3))]
         return ((self.state == UNKNOWN) & beside).reshape(-1)
 
     def contains(self, points: np.ndarray) -> np.ndarray:

@@ -63,7 +63,8 @@ class SurfaceVisibility:
 
     def __init__(self, occluders: Sequence[trimesh.Trimesh], target: trimesh.Trimesh, camera: UAVCamera,
                  points: int = 20_000, tolerance_m: float = 0.02, seed: int = 0) -> None:
-        self.samples = np.asarray(trimesh.sample.sample_surface(target, points, seed=seed)[0])
+        samples, faces = trimesh.sample.sample_surface(target, points, seed=seed)
+        self.samples, self.faces = np.asarray(samples), np.asarray(faces)
         self.caster = DepthRaycaster(occluders, camera.K, camera.width, camera.height)
         self.K, self.tolerance_m = camera.K, tolerance_m
 
@@ -71,12 +72,16 @@ class SurfaceVisibility:
         """(points,) True where a sample is seen from the OpenCV camera-to-world `c2w`."""
         return seen_mask(self.samples, self.caster.depth(c2w), self.K, c2w, self.tolerance_m)
 
-    def coverage(self, poses: Sequence[np.ndarray]) -> float:
-        """The share of the samples seen from at least one of the OpenCV camera-to-world `poses`."""
+    def seen_by(self, poses: Sequence[np.ndarray]) -> np.ndarray:
+        """(points,) True where a sample is seen from at least one of the OpenCV camera-to-world `poses`."""
         seen = np.zeros(len(self.samples), dtype=bool)
         for pose in poses:
             seen |= self.seen(pose)
-        return float(seen.mean())
+        return seen
+
+    def coverage(self, poses: Sequence[np.ndarray]) -> float:
+        """The share of the samples seen from at least one of the OpenCV camera-to-world `poses`."""
+        return float(self.seen_by(poses).mean())
 
 
 def scene_visibility(scene: Scene, camera: UAVCamera, points: int = 20_000, tolerance_m: float = 0.02,

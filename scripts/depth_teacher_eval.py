@@ -14,7 +14,8 @@ _stereo_back-up, _stereo_back-up_a2, _stereo_v). Round 27: `--frontier K` counts
 unknown voxels (name ending _fK), `--allowance M --excess W` charges W a metre more past M metres (_hMxW),
 `--patience N` gives up on unknown voxels N views reached without measuring (_pN), `--horizon H` scores H
 views ahead (_HH), `--next-to-free` counts only unknown voxels beside free space (_nf); `--distinct` flies
-each look-ahead again never stepping onto a view already flown (rounds 24 and 27; name ending _d).
+each look-ahead again never stepping onto a view already flown (rounds 24 and 27; name ending _d). Round 28:
+`--forward` steps as a pilot's orbit, always forward by 27.7 to 55.4 degrees (_fw).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -65,6 +66,8 @@ def arguments() -> argparse.Namespace:
     parser.add_argument("--horizon", type=int, default=HORIZON, help="views scored ahead of each step")
     parser.add_argument("--next-to-free", action="store_true",
                         help="a view sees only the unknown voxels beside free space it reaches")
+    parser.add_argument("--forward", action="store_true",
+                        help="every step advances the azimuth the same way, 27.7 to 55.4 degrees")
     looks_eval.study_arguments(parser)
     return parser.parse_args()
 
@@ -80,12 +83,14 @@ def main() -> None:
     options = (f"_f{args.frontier}" if args.frontier else "") \
         + (f"_h{args.allowance:g}x{args.excess:g}" if args.excess else "") \
         + (f"_p{args.patience}" if args.patience else "") \
-        + (f"_H{args.horizon}" if args.horizon != HORIZON else "") + ("_nf" if args.next_to_free else "")
+        + (f"_H{args.horizon}" if args.horizon != HORIZON else "") + ("_nf" if args.next_to_free else "") \
+        + ("_fw" if args.forward else "")
     suffix = "_stereo" + ("" if partners == STEREO_PARTNERS else "_" + "-".join(partners)) \
         + (f"_a{args.agree}" if args.agree else "") + ("_v" if args.votes else "") + options
     common = {"grid": args.grid_resolution, "rays": rays, "frontier": args.frontier,
               "allowance_m": args.allowance, "excess": args.excess, "patience": args.patience,
-              "horizon": args.horizon, "next_to_free": args.next_to_free}
+              "horizon": args.horizon, "next_to_free": args.next_to_free,
+              "forward": args.forward}
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"
         for distinct in (False, True) if args.distinct else (False,):

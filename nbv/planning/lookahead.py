@@ -32,7 +32,8 @@ hits against passes (`votes`) on the validation buildings: each passes the same 
 default. Round 27 (paper_results/selection/round27) tried counting only each ray's first unknown voxels
 (`frontier`), a battery's hinge on the flight (`allowance_m`, `excess`), giving up on what views flown
 looked at without measuring (`patience`), five views ahead (`horizon`) and counting only the unknown beside
-free space (`next_to_free`): none passes more, so none is the default either.
+free space (`next_to_free`): none passes more, so none is the default either. Round 28 tried the forward
+steps of a pilot's orbit (`forward`).
 """
 
 from __future__ import annotations
@@ -79,6 +80,9 @@ PARTNER_SIDES = ("back", "forward", "up")
 """Back or forward along the view's orbit, or up its meridian."""
 DEPTH_SOURCES = ("camera", "stereo")
 """Where the look-ahead's depth comes from: a depth camera, or plane-sweep stereo on two frames a view."""
+FORWARD_STEP = 2 / 13
+"""With `forward`, the steps' azimuth advance is half to all of this share of a turn (27.7 to 55.4 degrees a
+view: the tuned ring's step and the two rings' both inside; round 16's forward action space)."""
 
 
 class LookaheadPlanner(Planner):
@@ -92,7 +96,7 @@ class LookaheadPlanner(Planner):
                  partners: tuple[str, ...] = STEREO_PARTNERS, agree: int = STEREO_AGREE,
                  votes: bool = False, frontier: int = 0, allowance_m: float = 0.0,
                  excess: float = 0.0, patience: int = 0, horizon: int = HORIZON,
-                 next_to_free: bool = False) -> None:
+                 next_to_free: bool = False, forward: bool = False) -> None:
         """The flight weight a metre, the grid's voxels along its longest side, the rays across the image;
         `distinct`: never step onto a view already flown (else staying put may win where the flight costs
         more than the grid says is left); `depth`: one of `DEPTH_SOURCES`; `blank_images`: with stereo,
@@ -105,7 +109,9 @@ class LookaheadPlanner(Planner):
         as the teacher's hinge, `nbv.rl.flight_cost`); `patience` n > 0: an unknown voxel that n views flown
         have reached without measuring it counts as seen (stereo leaves texture it cannot match unknown);
         `horizon`: the views scored ahead of each candidate step; `next_to_free`: a view sees only the
-        unknown voxels it reaches that lie beside free space (`OccupancyGrid.frontier`)."""
+        unknown voxels it reaches that lie beside free space (`OccupancyGrid.frontier`); `forward`: the steps
+        are the `forward` action mode's (`nbv.rl.env.action_to_viewpoint`), each advancing the azimuth the
+        same way by 27.7 to 55.4 degrees (`FORWARD_STEP`), as a pilot's orbit: no reversal, no hovering."""
         if not 0 <= flight < float("inf") or min(grid, rays, frontier + 1) < 1 or depth not in DEPTH_SOURCES:
             raise ValueError(f"lookahead needs a finite flight weight >= 0, grid >= 1, rays >= 1, frontier "
                              f">= 0 and depth from {DEPTH_SOURCES}, got {flight}, {grid}, {rays}, "
@@ -123,7 +129,7 @@ class LookaheadPlanner(Planner):
         self.distinct, self.depth, self.blank_images = distinct, depth, blank_images
         self.partners, self.agree, self.votes, self.frontier = partners, agree, votes, frontier
         self.allowance_m, self.excess, self.patience, self.horizon = allowance_m, excess, patience, horizon
-        self.next_to_free = next_to_free
+        self.next_to_free, self.forward = next_to_free, forward
         if depth == "stereo":
             self.name = "lookahead-stereo"
 
@@ -133,7 +139,8 @@ class LookaheadPlanner(Planner):
         stride = max(1, round(camera.width / self.rays))
         grid = target_grid(world.target, OccupancyConfig(grid_resolution=self.grid, gain_ray_stride=stride,
                                                          votes=self.votes))
-        steps = replace(world.env, action_mode="orbit", relative_step=ORBIT_STEP)
+        steps = replace(world.env, action_mode="forward", relative_step=FORWARD_STEP) if self.forward \
+            else replace(world.env, action_mode="orbit", relative_step=ORBIT_STEP)
 
         seen: dict[tuple[float, float, float], np.ndarray] = {}  # this step's views (the grid is fixed)
 

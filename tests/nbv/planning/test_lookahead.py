@@ -13,6 +13,7 @@ from nbv.flight.path import azimuth_step, shell_path
 from nbv.planning.config import PlanSettings
 from nbv.planning.infogain import target_grid
 from nbv.planning.lookahead import (
+    FORWARD_STEP,
     LOOKAHEAD_FLIGHT,
     STEREO_BASELINE_M,
     STEREO_FLIGHT,
@@ -34,8 +35,8 @@ from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from tests.nbv.rl.test_bov_observation import config
 
 
-def steps_from(view, env) -> list:
-    orbit = replace(env, action_mode="orbit", relative_step=ORBIT_STEP)
+def steps_from(view, env, mode="orbit", step=ORBIT_STEP) -> list:
+    orbit = replace(env, action_mode=mode, relative_step=step)
     return [action_to_viewpoint(a, view, orbit) for a in CANDIDATES]
 
 
@@ -100,6 +101,18 @@ def test_next_to_free_sees_only_the_frontier_so_blank_frames_take_the_shortest_l
     assert shell_path(world.start, blind.plan(world, 2)[1:]).total_m == min(legs)  # nothing free: no gain
     looking = LookaheadPlanner(flight=0.0, grid=16, rays=8, next_to_free=True).plan(world, 2)
     assert shell_path(world.start, looking[1:]).total_m > min(legs)
+
+
+def test_forward_steps_always_advance_the_azimuth_one_way_and_a_dear_flight_takes_the_least():
+    world = PlanningWorld(config(), seed=3)
+    views = LookaheadPlanner(flight=0.0, grid=16, rays=8, forward=True).plan(world, 5)
+    advances = np.degrees([azimuth_step(a.azimuth, b.azimuth) for a, b in zip(views, views[1:])])
+    assert np.all((advances > 27.69) & (advances < 55.39))  # 27.7 to 55.4 degrees, never back
+    dear = LookaheadPlanner(flight=1e5, grid=16, rays=8, forward=True).plan(world, 2)
+    forward = steps_from(world.start, world.env, "forward", FORWARD_STEP)
+    legs = [shell_path(world.start, [s]).total_m for s in forward]
+    assert shell_path(world.start, dear[1:]).total_m == min(legs)
+    assert np.degrees(azimuth_step(world.start.azimuth, dear[1].azimuth)) == pytest.approx(360 / 13)
 
 
 def test_a_distinct_flight_never_repeats_a_view_where_staying_put_costs_least():

@@ -361,6 +361,8 @@ INDEX = (
            "twenty-seventh round: lookahead-stereo counting each ray's first unknown voxel or the unknown "
            "beside free space, a battery's hinge, patience with what stereo cannot measure and a longer "
            "horizon (not adopted), and what the courtyard loses", LOOKS_EVAL),
+    Result("selection/round28/README.md", "selection/round28/forward/results.json", "its twenty-eighth "
+           "round: lookahead-stereo on a pilot's forward steps (adopted: five of six checks)", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

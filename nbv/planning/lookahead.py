@@ -32,8 +32,9 @@ hits against passes (`votes`) on the validation buildings: each passes the same 
 default. Round 27 (paper_results/selection/round27) tried counting only each ray's first unknown voxels
 (`frontier`), a battery's hinge on the flight (`allowance_m`, `excess`), giving up on what views flown
 looked at without measuring (`patience`), five views ahead (`horizon`) and counting only the unknown beside
-free space (`next_to_free`): none passes more, so none is the default either. Round 28 tried the forward
-steps of a pilot's orbit (`forward`).
+free space (`next_to_free`): none passes more, so none is the default either. Round 28
+(paper_results/selection/round28) flew it on the forward steps of a pilot's orbit (`forward`): five of six
+checks on the validation buildings, so they are `lookahead-stereo`'s steps (`STEREO_FORWARD`).
 """
 
 from __future__ import annotations
@@ -76,6 +77,9 @@ STEREO_PARTNERS = ("back",)
 """Where `lookahead-stereo` takes each view's second frames, `STEREO_BASELINE_M` from it (`PARTNER_SIDES`)."""
 STEREO_AGREE = 0
 """How many pairs must agree on a depth for `lookahead-stereo` to fuse it (0: every pair's depth is fused)."""
+STEREO_FORWARD = True
+"""`lookahead-stereo` steps as a pilot's orbit, always forward (round 28, validation buildings: five of six
+checks, the first image-only planner to pass five; the teacher's steps either way passed four)."""
 PARTNER_SIDES = ("back", "forward", "up")
 """Back or forward along the view's orbit, or up its meridian."""
 DEPTH_SOURCES = ("camera", "stereo")
@@ -232,10 +236,11 @@ def lookahead_planner(settings: PlanSettings, seed: int, argument: str | None) -
 
 
 def stereo_lookahead_planner(settings: PlanSettings, seed: int, argument: str | None) -> LookaheadPlanner:
-    """The registry's `lookahead-stereo`: the look-ahead on stereo depth from two frames a view (the
-    validated weight, or `lookahead-stereo:W`)."""
+    """The registry's `lookahead-stereo`: the look-ahead on stereo depth from two frames a view, on forward
+    steps (the validated weight, or `lookahead-stereo:W`)."""
     flight = STEREO_FLIGHT if argument is None else flight_weight(argument)
-    return LookaheadPlanner(flight=flight, depth="stereo", blank_images=settings.blank_images)
+    return LookaheadPlanner(flight=flight, depth="stereo", blank_images=settings.blank_images,
+                            forward=STEREO_FORWARD)
 
 
 def flight_weight(argument: str) -> float:

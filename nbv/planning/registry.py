@@ -109,10 +109,11 @@ PLANNERS: tuple[PlannerEntry, ...] = (
                  "of an occupancy grid fused from the depth flown, less 0.07 a metre flown (lookahead:W "
                  "another weight)", "nbv.planning.lookahead:lookahead_planner", argument="W", budget=False,
                  depth_option=True),
-    PlannerEntry("lookahead-stereo", "the same look-ahead on what a camera alone measures: the grid fused "
-                 "from plane-sweep stereo depth of each view and a second frame 0.25 m along its orbit "
-                 "(reads images and poses, as the policies do), less 0.1 a metre (lookahead-stereo:W another "
-                 "weight)",
+    PlannerEntry("lookahead-stereo", "the same look-ahead on what a camera alone measures, flying a "
+                 "pilot's orbit: each step 27.7 to 55.4 degrees forward round the target, its radius and "
+                 "elevation the look-ahead's choice; the grid fused from plane-sweep stereo depth of each "
+                 "view and a second frame 0.25 m back along its orbit (reads images and poses, as the "
+                 "policies do), less 0.1 a metre (lookahead-stereo:W another weight)",
                  "nbv.planning.lookahead:stereo_lookahead_planner", settings=("blank_images",), argument="W",
                  budget=False, image_option=True),
     PlannerEntry("policy", "a trained actor (a `nbv train` checkpoint.pt or policy.pt; none: the shipped "

@@ -214,7 +214,8 @@ def test_stereo_measures_the_building_and_blank_frames_measure_nothing():
     views = LookaheadPlanner(grid=16, rays=8, depth="stereo").plan(small, 3)
     assert views[0] == small.start and len(views) == 3
     stereo = make_planner("lookahead-stereo", PlanSettings())
-    assert (stereo.name, stereo.flight, stereo.depth) == ("lookahead-stereo", STEREO_FLIGHT, "stereo")
+    assert (stereo.name, stereo.flight, stereo.depth, stereo.forward) == ("lookahead-stereo", STEREO_FLIGHT,
+                                                                          "stereo", True)
     assert make_planner("lookahead-stereo:0.2", PlanSettings(blank_images=True)).blank_images
     with pytest.raises(ValueError, match="depth from"):
         LookaheadPlanner(depth="lidar")

@@ -24,11 +24,18 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 from common.io import atomic_folder
 from nbv.planning.config import PlanSettings
-from nbv.planning.lookahead import HORIZON, PARTNER_SIDES, STEREO_PARTNERS, LookaheadPlanner
+from nbv.planning.lookahead import (
+    HORIZON,
+    PARTNER_SIDES,
+    STEREO_PARTNERS,
+    LookaheadOptions,
+    LookaheadPlanner,
+)
 from nbv.planning.registry import make_planner
 from nbv.rl.presets import default_preset
 
@@ -80,28 +87,29 @@ def main() -> None:
     planners = {name: (make_planner(name, PlanSettings()), False) for name in ("orbit", "orbit2", "random")}
     names, blanks = [], {}
     partners = tuple(args.partners)
-    options = (f"_f{args.frontier}" if args.frontier else "") \
+    named = (f"_f{args.frontier}" if args.frontier else "") \
         + (f"_h{args.allowance:g}x{args.excess:g}" if args.excess else "") \
         + (f"_p{args.patience}" if args.patience else "") \
         + (f"_H{args.horizon}" if args.horizon != HORIZON else "") + ("_nf" if args.next_to_free else "") \
         + ("_fw" if args.forward else "")
     suffix = "_stereo" + ("" if partners == STEREO_PARTNERS else "_" + "-".join(partners)) \
-        + (f"_a{args.agree}" if args.agree else "") + ("_v" if args.votes else "") + options
-    common = {"grid": args.grid_resolution, "rays": rays, "frontier": args.frontier,
-              "allowance_m": args.allowance, "excess": args.excess, "patience": args.patience,
-              "horizon": args.horizon, "next_to_free": args.next_to_free,
-              "forward": args.forward}
+        + (f"_a{args.agree}" if args.agree else "") + ("_v" if args.votes else "") + named
+    options = LookaheadOptions(frontier=args.frontier, allowance_m=args.allowance, excess=args.excess,
+                               patience=args.patience, horizon=args.horizon, next_to_free=args.next_to_free,
+                               forward=args.forward)
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"
         for distinct in (False, True) if args.distinct else (False,):
             if not args.no_camera:
-                camera = name + "_d" * distinct + options
-                planners[camera] = (LookaheadPlanner(flight=w, distinct=distinct, **common), False)
+                camera = name + "_d" * distinct + named
+                planners[camera] = (LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays,
+                                                     options=replace(options, distinct=distinct)), False)
                 names.append(camera)
             if args.stereo:
-                stereo = {blank: LookaheadPlanner(flight=w, distinct=distinct, depth="stereo",
-                                                  blank_images=blank, partners=partners, agree=args.agree,
-                                                  votes=args.votes, **common)
+                sides = replace(options, distinct=distinct, partners=partners, agree=args.agree,
+                                votes=args.votes)
+                stereo = {blank: LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays,
+                                                  depth="stereo", blank_images=blank, options=sides)
                           for blank in (False, True)}
                 flown = name + suffix + "_d" * distinct
                 planners[flown], blanks[flown] = (stereo[False], False), stereo[True]

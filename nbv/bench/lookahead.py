@@ -13,7 +13,7 @@ import time
 
 from common.threads import set_torch_threads
 from nbv.bench import BenchResult
-from nbv.planning.lookahead import LookaheadPlanner
+from nbv.planning.lookahead import LookaheadOptions, LookaheadPlanner
 from nbv.planning.world import PlanningWorld
 from nbv.rl.presets import default_preset
 from nbv.rl.validate import evaluation_env_config
@@ -22,9 +22,10 @@ from scenes.spec import SceneSet
 
 PLANNERS = {
     "depth camera": LookaheadPlanner(),
-    "stereo, one second frame (back)": LookaheadPlanner(depth="stereo", partners=("back",)),
-    "stereo, three second frames (back, forward, up)": LookaheadPlanner(depth="stereo",
-                                                                        partners=("back", "forward", "up")),
+    "stereo, one second frame (back)": LookaheadPlanner(depth="stereo",
+                                                        options=LookaheadOptions(partners=("back",))),
+    "stereo, three second frames (back, forward, up)": LookaheadPlanner(
+        depth="stereo", options=LookaheadOptions(partners=("back", "forward", "up"))),
 }
 """The look-aheads timed, by label."""
 

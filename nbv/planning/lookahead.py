@@ -39,7 +39,7 @@ checks on the validation buildings, so they are `lookahead-stereo`'s steps (`STE
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -89,61 +89,81 @@ FORWARD_STEP = 2 / 13
 view: the tuned ring's step and the two rings' both inside; round 16's forward action space)."""
 
 
+@dataclass(frozen=True, kw_only=True)
+class LookaheadOptions:
+    """The look-ahead's variants, each flown on the validation buildings (rounds 24 to 28; the defaults are
+    the teacher's, `forward` `lookahead-stereo`'s own, `STEREO_FORWARD`)."""
+
+    distinct: bool = False
+    """Never step onto a view already flown (else staying put may win where the flight costs more than the
+    grid says is left)."""
+    partners: tuple[str, ...] = STEREO_PARTNERS
+    """With stereo, the sides of the view its second frames are taken on (`PARTNER_SIDES`), each swept with
+    it."""
+    agree: int = STEREO_AGREE
+    """With stereo, 0 fuses every pair's depth of both its frames, N >= 1 only the view's depth that N pairs
+    agree on (`agreed_depth`)."""
+    votes: bool = False
+    """The grid weighs hits against passes (`OccupancyConfig.votes`)."""
+    frontier: int = 0
+    """k > 0: a view sees only each ray's first k unknown voxels (`OccupancyGrid.reached`)."""
+    allowance_m: float = 0.0
+    """Metres of the flight before `excess` is charged (a battery's budget, the teacher's hinge,
+    `nbv.rl.flight_cost`)."""
+    excess: float = 0.0
+    """Coverage points a metre more for the flight past `allowance_m`."""
+    patience: int = 0
+    """n > 0: an unknown voxel that n views flown have reached without measuring it counts as seen (stereo
+    leaves texture it cannot match unknown)."""
+    horizon: int = HORIZON
+    """The views scored ahead of each candidate step."""
+    next_to_free: bool = False
+    """A view sees only the unknown voxels it reaches that lie beside free space
+    (`OccupancyGrid.frontier`)."""
+    forward: bool = False
+    """The steps are the `forward` action mode's (`nbv.rl.env.action_to_viewpoint`), each advancing the
+    azimuth the same way by 27.7 to 55.4 degrees (`FORWARD_STEP`), as a pilot's orbit: no reversal, no
+    hovering."""
+
+    def __post_init__(self) -> None:
+        if self.frontier < 0 or self.patience < 0 or self.horizon < 1:
+            raise ValueError(f"lookahead's frontier and patience are counts >= 0 (0: off) and its horizon "
+                             f">= 1, got {self.frontier}, {self.patience}, {self.horizon}")
+        if not (0 <= self.allowance_m < float("inf") and 0 <= self.excess < float("inf")):
+            raise ValueError(f"lookahead's flight allowance and excess weight are finite and >= 0, got "
+                             f"{self.allowance_m}, {self.excess}")
+        if not self.partners or not set(self.partners) <= set(PARTNER_SIDES) \
+                or not 0 <= self.agree <= len(self.partners):
+            raise ValueError(f"lookahead-stereo's partners are sides from {PARTNER_SIDES} and agree 0 to "
+                             f"their number, got {self.partners}, {self.agree}")
+
+
 class LookaheadPlanner(Planner):
     """The teacher's look-ahead on an occupancy grid fused from the depth flown (module docstring)."""
 
     name = "lookahead"
 
     def __init__(self, flight: float = LOOKAHEAD_FLIGHT, grid: int = LOOKAHEAD_GRID,
-                 rays: int = LOOKAHEAD_RAYS, default_views: int = 13, distinct: bool = False,
-                 depth: str = "camera", blank_images: bool = False,
-                 partners: tuple[str, ...] = STEREO_PARTNERS, agree: int = STEREO_AGREE,
-                 votes: bool = False, frontier: int = 0, allowance_m: float = 0.0,
-                 excess: float = 0.0, patience: int = 0, horizon: int = HORIZON,
-                 next_to_free: bool = False, forward: bool = False) -> None:
+                 rays: int = LOOKAHEAD_RAYS, default_views: int = 13, depth: str = "camera",
+                 blank_images: bool = False, options: LookaheadOptions = LookaheadOptions()) -> None:
         """The flight weight a metre, the grid's voxels along its longest side, the rays across the image;
-        `distinct`: never step onto a view already flown (else staying put may win where the flight costs
-        more than the grid says is left); `depth`: one of `DEPTH_SOURCES`; `blank_images`: with stereo,
-        every captured frame replaced by a blank one (the evaluation's test that it looks); `partners`: with
-        stereo, the sides of the view its second frames are taken on (`PARTNER_SIDES`), each swept with it;
-        `agree`: 0 fuses every pair's depth of both its frames, N >= 1 only the view's depth that N pairs
-        agree on (`agreed_depth`); `votes`: the grid weighs hits against passes (`OccupancyConfig.votes`);
-        `frontier` k > 0: a view sees only each ray's first k unknown voxels (`OccupancyGrid.reached`);
-        `excess`: coverage points a metre more for the flight past `allowance_m` metres (a battery's budget,
-        as the teacher's hinge, `nbv.rl.flight_cost`); `patience` n > 0: an unknown voxel that n views flown
-        have reached without measuring it counts as seen (stereo leaves texture it cannot match unknown);
-        `horizon`: the views scored ahead of each candidate step; `next_to_free`: a view sees only the
-        unknown voxels it reaches that lie beside free space (`OccupancyGrid.frontier`); `forward`: the steps
-        are the `forward` action mode's (`nbv.rl.env.action_to_viewpoint`), each advancing the azimuth the
-        same way by 27.7 to 55.4 degrees (`FORWARD_STEP`), as a pilot's orbit: no reversal, no hovering."""
-        if not 0 <= flight < float("inf") or min(grid, rays, frontier + 1) < 1 or depth not in DEPTH_SOURCES:
-            raise ValueError(f"lookahead needs a finite flight weight >= 0, grid >= 1, rays >= 1, frontier "
-                             f">= 0 and depth from {DEPTH_SOURCES}, got {flight}, {grid}, {rays}, "
-                             f"{frontier}, {depth!r}")
-        if patience < 0 or horizon < 1:
-            raise ValueError(f"lookahead's patience is a count of views >= 0 (0: never) and its horizon "
-                             f">= 1, got {patience}, {horizon}")
-        if not (0 <= allowance_m < float("inf") and 0 <= excess < float("inf")):
-            raise ValueError(f"lookahead's flight allowance and excess weight are finite and >= 0, got "
-                             f"{allowance_m}, {excess}")
-        if not partners or not set(partners) <= set(PARTNER_SIDES) or not 0 <= agree <= len(partners):
-            raise ValueError(f"lookahead-stereo's partners are sides from {PARTNER_SIDES} and agree 0 to "
-                             f"their number, got {partners}, {agree}")
+        `depth`: one of `DEPTH_SOURCES`; `blank_images`: with stereo, every captured frame replaced by a
+        blank one (the evaluation's test that it looks); `options`: the variants (`LookaheadOptions`)."""
+        if not 0 <= flight < float("inf") or min(grid, rays) < 1 or depth not in DEPTH_SOURCES:
+            raise ValueError(f"lookahead needs a finite flight weight >= 0, grid >= 1, rays >= 1 and depth "
+                             f"from {DEPTH_SOURCES}, got {flight}, {grid}, {rays}, {depth!r}")
         self.flight, self.grid, self.rays, self.default_views = flight, grid, rays, default_views
-        self.distinct, self.depth, self.blank_images = distinct, depth, blank_images
-        self.partners, self.agree, self.votes, self.frontier = partners, agree, votes, frontier
-        self.allowance_m, self.excess, self.patience, self.horizon = allowance_m, excess, patience, horizon
-        self.next_to_free, self.forward = next_to_free, forward
+        self.depth, self.blank_images, self.options = depth, blank_images, options
         if depth == "stereo":
             self.name = "lookahead-stereo"
 
     def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """The start view, then each next one the orbit step whose look-ahead on the grid scores best."""
-        camera, center = world.camera, world.target.center()
+        camera, center, options = world.camera, world.target.center(), self.options
         stride = max(1, round(camera.width / self.rays))
         grid = target_grid(world.target, OccupancyConfig(grid_resolution=self.grid, gain_ray_stride=stride,
-                                                         votes=self.votes))
-        steps = replace(world.env, action_mode="forward", relative_step=FORWARD_STEP) if self.forward \
+                                                         votes=options.votes))
+        steps = replace(world.env, action_mode="forward", relative_step=FORWARD_STEP) if options.forward \
             else replace(world.env, action_mode="orbit", relative_step=ORBIT_STEP)
 
         seen: dict[tuple[float, float, float], np.ndarray] = {}  # this step's views (the grid is fixed)
@@ -152,8 +172,8 @@ class LookaheadPlanner(Planner):
             key = (round(view.radius, 9), round(view.azimuth % (2 * np.pi), 9), round(view.elevation, 9))
             if key not in seen:
                 seen[key] = grid.reached(camera.K, viewpoint_to_c2w(view, center), camera.width,
-                                         camera.height, stride, self.frontier)
-                if self.next_to_free:
+                                         camera.height, stride, options.frontier)
+                if options.next_to_free:
                     seen[key] &= edge
             return seen[key]
 
@@ -165,21 +185,20 @@ class LookaheadPlanner(Planner):
         for left in range((self.default_views if views is None else views) - 1, 0, -1):
             self.measure(world, grid, view)
             seen.clear()
-            edge = grid.frontier() if self.next_to_free else None
+            edge = grid.frontier() if options.next_to_free else None
             known = grid.state.reshape(-1) != UNKNOWN
-            if self.patience:
+            if options.patience:
                 looked += sees(view)
-                known |= looked >= self.patience
-            scores = expert_scores(view, known, sees, step, self.flight, left, self.horizon, DISCOUNT,
+                known |= looked >= options.patience
+            scores = expert_scores(view, known, sees, step, self.flight, left, options.horizon, DISCOUNT,
                                    flown_m=shell_path(chosen[0], chosen[1:]).total_m,
-                                   allowance_m=self.allowance_m, excess_weight=self.excess)
-            if self.distinct:
+                                   allowance_m=options.allowance_m, excess_weight=options.excess)
+            if options.distinct:
                 repeats = np.array([revisits(step(action, view), chosen) for action in CANDIDATES])
                 scores = np.where(repeats, -np.inf, scores) if not repeats.all() else scores
             view = step(best_action(scores), view)
             chosen.append(view)
         return chosen
-
 
     def measure(self, world: PlanningWorld, grid: OccupancyGrid, view: Viewpoint) -> None:
         """Fuse what the UAV measures at `view` into the grid: the depth camera's image, or stereo depth of
@@ -196,14 +215,15 @@ class LookaheadPlanner(Planner):
 
         image, pose = frame(view), viewpoint_to_c2w(view, center)
         fused, views = [], []
-        for side in self.partners:
+        for side in self.options.partners:
             partner = stereo_partner(view, side=side)
             other = viewpoint_to_c2w(partner, center)
             fused.extend(box_stereo_depth(image, frame(partner), camera.K, pose, other, grid.lower,
                                           grid.upper))
             views.extend((pose, other))
-        if self.agree:
-            fused, views = [agreed_depth(fused[::2], StereoConfig().consistency, self.agree)], [pose]
+        if self.options.agree:
+            fused, views = [agreed_depth(fused[::2], StereoConfig().consistency,
+                                          self.options.agree)], [pose]
         for depth, at in zip(fused, views, strict=True):
             grid.integrate(depth, camera.K, at, stride)
 
@@ -240,7 +260,7 @@ def stereo_lookahead_planner(settings: PlanSettings, seed: int, argument: str | 
     steps (the validated weight, or `lookahead-stereo:W`)."""
     flight = STEREO_FLIGHT if argument is None else flight_weight(argument)
     return LookaheadPlanner(flight=flight, depth="stereo", blank_images=settings.blank_images,
-                            forward=STEREO_FORWARD)
+                            options=LookaheadOptions(forward=STEREO_FORWARD))
 
 
 def flight_weight(argument: str) -> float:

@@ -17,6 +17,7 @@ from nbv.planning.lookahead import (
     LOOKAHEAD_FLIGHT,
     STEREO_BASELINE_M,
     STEREO_FLIGHT,
+    LookaheadOptions,
     LookaheadPlanner,
     lookahead_planner,
     revisits,
@@ -33,6 +34,12 @@ from render.camera import UAVCamera
 from render.settings import RenderSettings
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from tests.nbv.rl.test_bov_observation import config
+
+
+def tiny(flight: float = 0.0, depth: str = "camera", blank: bool = False, **options) -> LookaheadPlanner:
+    """A look-ahead on a 16-voxel grid casting 8 rays across, its `LookaheadOptions` by keyword."""
+    return LookaheadPlanner(flight=flight, grid=16, rays=8, depth=depth, blank_images=blank,
+                            options=LookaheadOptions(**options))
 
 
 def steps_from(view, env, mode="orbit", step=ORBIT_STEP) -> list:
@@ -63,12 +70,12 @@ def test_past_its_allowance_a_hinged_flight_takes_the_shortest_leg_and_free_befo
     env = config()
     world = PlanningWorld(env, seed=3)
     free = LookaheadPlanner(flight=0.0, grid=16, rays=8).plan(world, 3)
-    assert LookaheadPlanner(flight=0.0, grid=16, rays=8, allowance_m=1e3, excess=1e5).plan(world, 3) == free
-    views = LookaheadPlanner(flight=0.0, grid=16, rays=8, allowance_m=0.0, excess=1e5).plan(world, 2)
+    assert tiny(0.0, allowance_m=1e3, excess=1e5).plan(world, 3) == free
+    views = tiny(0.0, allowance_m=0.0, excess=1e5).plan(world, 2)
     legs = [shell_path(world.start, [s]).total_m for s in steps_from(world.start, env)]
     assert shell_path(world.start, views[1:]).total_m == min(legs)
     with pytest.raises(ValueError, match="allowance and excess weight are finite and >= 0, got 1.0, -2"):
-        LookaheadPlanner(allowance_m=1.0, excess=-2)
+        LookaheadOptions(allowance_m=1.0, excess=-2)
 
 
 def test_with_patience_it_gives_up_on_what_it_looked_at_without_measuring():
@@ -81,34 +88,32 @@ def test_with_patience_it_gives_up_on_what_it_looked_at_without_measuring():
 
     overlap = {}
     for patience in (0, 1):
-        planner = LookaheadPlanner(flight=0.0, grid=16, rays=8, depth="stereo", blank_images=True,
-                                   patience=patience)
+        planner = tiny(0.0, "stereo", True, patience=patience)
         views = planner.plan(world, 2)
         overlap[patience] = np.count_nonzero(reached(views[1]) & reached(world.start))
     assert overlap[1] < overlap[0]  # it turns from what the start view looked at
-    with pytest.raises(ValueError, match="patience is a count of views >= 0 .* got -1, 3"):
-        LookaheadPlanner(patience=-1)
-    with pytest.raises(ValueError, match="its horizon >= 1, got 0, 0"):
-        LookaheadPlanner(horizon=0)
+    with pytest.raises(ValueError, match=r"frontier and patience are counts >= 0 \(0: off\) .* got 0, -1, 3"):
+        LookaheadOptions(patience=-1)
+    with pytest.raises(ValueError, match="its horizon >= 1, got 0, 0, 0"):
+        LookaheadOptions(horizon=0)
 
 
 def test_next_to_free_sees_only_the_frontier_so_blank_frames_take_the_shortest_leg():
     env = config()
     world = PlanningWorld(env, seed=3)
     legs = [shell_path(world.start, [s]).total_m for s in steps_from(world.start, env)]
-    blind = LookaheadPlanner(flight=0.0, grid=16, rays=8, depth="stereo", blank_images=True,
-                             next_to_free=True)
+    blind = tiny(0.0, "stereo", True, next_to_free=True)
     assert shell_path(world.start, blind.plan(world, 2)[1:]).total_m == min(legs)  # nothing free: no gain
-    looking = LookaheadPlanner(flight=0.0, grid=16, rays=8, next_to_free=True).plan(world, 2)
+    looking = tiny(0.0, next_to_free=True).plan(world, 2)
     assert shell_path(world.start, looking[1:]).total_m > min(legs)
 
 
 def test_forward_steps_always_advance_the_azimuth_one_way_and_a_dear_flight_takes_the_least():
     world = PlanningWorld(config(), seed=3)
-    views = LookaheadPlanner(flight=0.0, grid=16, rays=8, forward=True).plan(world, 5)
+    views = tiny(0.0, forward=True).plan(world, 5)
     advances = np.degrees([azimuth_step(a.azimuth, b.azimuth) for a, b in zip(views, views[1:])])
     assert np.all((advances > 27.69) & (advances < 55.39))  # 27.7 to 55.4 degrees, never back
-    dear = LookaheadPlanner(flight=1e5, grid=16, rays=8, forward=True).plan(world, 2)
+    dear = tiny(1e5, forward=True).plan(world, 2)
     forward = steps_from(world.start, world.env, "forward", FORWARD_STEP)
     legs = [shell_path(world.start, [s]).total_m for s in forward]
     assert shell_path(world.start, dear[1:]).total_m == min(legs)
@@ -119,7 +124,7 @@ def test_a_distinct_flight_never_repeats_a_view_where_staying_put_costs_least():
     world = PlanningWorld(config(), seed=3)
     stays = LookaheadPlanner(flight=1e5, grid=16, rays=8).plan(world, 4)
     assert stays[1] == stays[2] == stays[3]  # on the steps' levels, staying put is a step, and free
-    views = LookaheadPlanner(flight=1e5, grid=16, rays=8, distinct=True).plan(world, 4)
+    views = tiny(1e5, distinct=True).plan(world, 4)
     assert views[1] == stays[1] and not any(revisits(view, views[:i]) for i, view in enumerate(views) if i)
     moves = [shell_path(views[1], [s]).total_m for s in steps_from(views[1], world.env)
              if not revisits(s, views[:2])]
@@ -140,8 +145,10 @@ def test_the_spec_sets_the_flight_weight_and_refuses_bad_ones():
         lookahead_planner(PlanSettings(), 0, "fast")
     with pytest.raises(ValueError, match="finite flight weight >= 0"):
         lookahead_planner(PlanSettings(), 0, "-1")
-    with pytest.raises(ValueError, match="frontier >= 0 .* got 0.07, 48, 40, -1"):
-        LookaheadPlanner(frontier=-1)
+    with pytest.raises(ValueError, match="grid >= 1, rays >= 1 and depth from .* got 0.07, 48, 0, 'camera'"):
+        LookaheadPlanner(rays=0)
+    with pytest.raises(ValueError, match="counts >= 0 .* got -1, 0, 3"):
+        LookaheadOptions(frontier=-1)
 
 
 def test_the_second_frame_is_the_baseline_back_along_the_orbit():
@@ -174,14 +181,14 @@ def test_more_second_frames_measure_at_least_as_much():
     for partners in (("back",), ("back", "up")):
         world = PlanningWorld(config(camera=UAVCamera(160, 120), render=RenderSettings(spp=4)), seed=3)
         grid = target_grid(world.target, OccupancyConfig(grid_resolution=16))
-        LookaheadPlanner(grid=16, rays=8, depth="stereo", partners=partners).measure(world, grid, world.start)
+        tiny(depth="stereo", partners=partners).measure(world, grid, world.start)
         known[partners] = grid.state != UNKNOWN
     assert known["back", "up"].sum() > known["back",].sum()
     assert np.all(known["back", "up"][known["back",]])  # the first pair's knowledge is kept
     with pytest.raises(ValueError, match="partners are sides from"):
-        LookaheadPlanner(depth="stereo", partners=("down",))
+        LookaheadOptions(partners=("down",))
     with pytest.raises(ValueError, match="agree 0 to their number"):
-        LookaheadPlanner(depth="stereo", partners=("back", "up"), agree=3)
+        LookaheadOptions(partners=("back", "up"), agree=3)
     with pytest.raises(ValueError, match="side is one of"):
         stereo_partner(Viewpoint(2.0, 0.1, 0.5), side="left")
 
@@ -191,12 +198,11 @@ def test_fusing_only_what_pairs_agree_on_knows_less_than_every_pair():
     for agree in (0, 2):
         world = PlanningWorld(config(camera=UAVCamera(160, 120), render=RenderSettings(spp=4)), seed=3)
         grid = target_grid(world.target, OccupancyConfig(grid_resolution=16))
-        planner = LookaheadPlanner(grid=16, rays=8, depth="stereo", partners=("back", "forward", "up"),
-                                   agree=agree)
+        planner = tiny(depth="stereo", partners=("back", "forward", "up"), agree=agree)
         planner.measure(world, grid, world.start)
         known[agree] = (grid.state != UNKNOWN).sum()
     assert 0 < known[2] < known[0]
-    voting = LookaheadPlanner(grid=16, rays=8, depth="stereo", votes=True)
+    voting = tiny(LOOKAHEAD_FLIGHT, "stereo", votes=True)
     assert len(voting.plan(PlanningWorld(config(), seed=3), 3)) == 3
     assert target_grid(world.target, OccupancyConfig(grid_resolution=16, votes=True)).votes
 
@@ -214,8 +220,8 @@ def test_stereo_measures_the_building_and_blank_frames_measure_nothing():
     views = LookaheadPlanner(grid=16, rays=8, depth="stereo").plan(small, 3)
     assert views[0] == small.start and len(views) == 3
     stereo = make_planner("lookahead-stereo", PlanSettings())
-    assert (stereo.name, stereo.flight, stereo.depth, stereo.forward) == ("lookahead-stereo", STEREO_FLIGHT,
-                                                                          "stereo", True)
+    assert (stereo.name, stereo.flight, stereo.depth) == ("lookahead-stereo", STEREO_FLIGHT, "stereo")
+    assert stereo.options == LookaheadOptions(forward=True)
     assert make_planner("lookahead-stereo:0.2", PlanSettings(blank_images=True)).blank_images
     with pytest.raises(ValueError, match="depth from"):
         LookaheadPlanner(depth="lidar")

@@ -83,6 +83,8 @@ STEREO_AGREE = 0
 STEREO_FORWARD = True
 """`lookahead-stereo` steps as a pilot's orbit, always forward (round 28, validation buildings: five of six
 checks, the first image-only planner to pass five; the teacher's steps either way passed four)."""
+ORIGIN = np.zeros(3)
+"""Where `crowds` puts the target's centre: distances between cameras do not depend on it."""
 PARTNER_SIDES = ("back", "forward", "up")
 """Back or forward along the view's orbit, or up its meridian."""
 DEPTH_SOURCES = ("camera", "stereo")
@@ -127,6 +129,9 @@ class LookaheadOptions:
     """The steps are the `forward` action mode's (`nbv.rl.env.action_to_viewpoint`), each advancing the
     azimuth the same way by 27.7 to 55.4 degrees (`FORWARD_STEP`), as a pilot's orbit: no reversal, no
     hovering."""
+    spacing_m: float = 0.0
+    """> 0: never step to a camera position within this many metres (straight line) of a view flown (once
+    every step would, the rule is dropped for that step)."""
 
     def __post_init__(self) -> None:
         if self.frontier < 0 or self.patience < 0 or self.horizon < 1:
@@ -135,6 +140,9 @@ class LookaheadOptions:
         if not (0 <= self.allowance_m < float("inf") and 0 <= self.excess < float("inf")):
             raise ValueError(f"lookahead's flight allowance and excess weight are finite and >= 0, got "
                              f"{self.allowance_m}, {self.excess}")
+        if not 0 <= self.spacing_m < float("inf"):
+            raise ValueError(f"lookahead's spacing is a finite distance >= 0 (0: none), got "
+                             f"{self.spacing_m}")
         if not self.partners or not set(self.partners) <= set(PARTNER_SIDES) \
                 or not 0 <= self.agree <= len(self.partners):
             raise ValueError(f"lookahead-stereo's partners are sides from {PARTNER_SIDES} and agree 0 to "
@@ -196,9 +204,11 @@ class LookaheadPlanner(Planner):
             scores = expert_scores(view, known, sees, step, self.flight, left, options.horizon, DISCOUNT,
                                    flown_m=shell_path(chosen[0], chosen[1:]).total_m,
                                    allowance_m=options.allowance_m, excess_weight=options.excess)
-            if options.distinct:
-                repeats = np.array([revisits(step(action, view), chosen) for action in CANDIDATES])
-                scores = np.where(repeats, -np.inf, scores) if not repeats.all() else scores
+            if options.distinct or options.spacing_m:
+                nexts = [step(action, view) for action in CANDIDATES]
+                ruled = np.array([crowds(n, chosen, options.spacing_m) if options.spacing_m
+                                  else revisits(n, chosen) for n in nexts])
+                scores = np.where(ruled, -np.inf, scores) if not ruled.all() else scores
             view = step(best_action(scores), view)
             chosen.append(view)
         return chosen
@@ -249,6 +259,12 @@ def revisits(view: Viewpoint, flown: list[Viewpoint], tolerance: float = 1e-6) -
     `tolerance`)."""
     return any(abs(view.radius - f.radius) <= tolerance and abs(view.elevation - f.elevation) <= tolerance
                and abs(azimuth_step(f.azimuth, view.azimuth)) <= tolerance for f in flown)
+
+
+def crowds(view: Viewpoint, flown: list[Viewpoint], spacing_m: float) -> bool:
+    """Whether `view`'s camera lies within `spacing_m` metres (a straight line) of a view `flown`'s."""
+    here = viewpoint_to_c2w(view, ORIGIN)[:3, 3]
+    return any(np.linalg.norm(here - viewpoint_to_c2w(f, ORIGIN)[:3, 3]) < spacing_m for f in flown)
 
 
 def lookahead_planner(settings: PlanSettings, seed: int, argument: str | None) -> LookaheadPlanner:

@@ -19,6 +19,7 @@ from nbv.planning.lookahead import (
     STEREO_FLIGHT,
     LookaheadOptions,
     LookaheadPlanner,
+    crowds,
     lookahead_planner,
     revisits,
     stereo_partner,
@@ -118,6 +119,23 @@ def test_forward_steps_always_advance_the_azimuth_one_way_and_a_dear_flight_take
     legs = [shell_path(world.start, [s]).total_m for s in forward]
     assert shell_path(world.start, dear[1:]).total_m == min(legs)
     assert np.degrees(azimuth_step(world.start.azimuth, dear[1].azimuth)) == pytest.approx(360 / 13)
+
+
+def test_crowds_measures_the_straight_line_between_cameras():
+    flown = [Viewpoint(1.0, 0.0, 0.0)]
+    assert crowds(Viewpoint(1.0, np.pi / 3, 0.0), flown, 1.01)  # a 60-degree chord of a 1 m orbit: 1 m
+    assert not crowds(Viewpoint(1.0, np.pi / 3, 0.0), flown, 0.99)
+    assert not crowds(Viewpoint(1.0, 0.0, 0.0), [], 1.0)
+
+
+def test_a_spaced_flight_never_steps_near_a_camera_flown():
+    world = PlanningWorld(config(), seed=3)
+    dear = tiny(1e5, forward=True).plan(world, 4)
+    assert crowds(dear[1], dear[:1], 0.6)  # the shortest forward step lands within 0.6 m
+    spaced = tiny(1e5, forward=True, spacing_m=0.6).plan(world, 4)
+    assert not any(crowds(view, spaced[:i], 0.6) for i, view in enumerate(spaced) if i)
+    with pytest.raises(ValueError, match="spacing is a finite distance >= 0 .* got -0.1"):
+        LookaheadOptions(spacing_m=-0.1)
 
 
 def test_a_distinct_flight_never_repeats_a_view_where_staying_put_costs_least():

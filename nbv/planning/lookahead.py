@@ -37,7 +37,8 @@ the unknown beside free space (`next_to_free`): none passes more, so none is the
 checks on the validation buildings, so they are `lookahead-stereo`'s steps (`STEREO_FORWARD`). Held out,
 scored once (paper_results/online/stereo): 3.9 points above the ring in 1.29x its metres, 4.3 lost with blank
 frames, 1.7 under the ring on the walled compound, where it ends its flights near-hovering at 80 degrees (a
-forward step there is an arc of 0.13 m).
+forward step there is an arc of 0.13 m). Round 29 (paper_results/selection/round29) never stepped within 0.25
+or 0.5 m of a camera flown (`spacing_m`): more coverage, past the metres bar, so not the default.
 """
 
 from __future__ import annotations
@@ -96,7 +97,7 @@ view: the tuned ring's step and the two rings' both inside; round 16's forward a
 
 @dataclass(frozen=True, kw_only=True)
 class LookaheadOptions:
-    """The look-ahead's variants, each flown on the validation buildings (rounds 24 to 28; the defaults are
+    """The look-ahead's variants, each flown on the validation buildings (rounds 24 to 29; the defaults are
     the teacher's, `forward` `lookahead-stereo`'s own, `STEREO_FORWARD`)."""
 
     distinct: bool = False

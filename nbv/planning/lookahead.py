@@ -128,8 +128,8 @@ class LookaheadOptions:
     (`OccupancyGrid.frontier`)."""
     forward: bool = False
     """The steps are the `forward` action mode's (`nbv.rl.env.action_to_viewpoint`), each advancing the
-    azimuth the same way by 27.7 to 55.4 degrees (`FORWARD_STEP`), as a pilot's orbit: no reversal, no
-    hovering."""
+    azimuth the same way by 27.7 to 55.4 degrees (`FORWARD_STEP`), as a pilot's orbit: no reversal, never
+    standing still (though at 80 degrees and 1.5 m a 27.7-degree step is a 0.13 m arc, round 28)."""
     spacing_m: float = 0.0
     """> 0: never step to a camera position within this many metres (straight line) of a view flown (once
     every step would, the rule is dropped for that step)."""

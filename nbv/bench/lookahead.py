@@ -4,7 +4,8 @@ Each planner flies the same views on the built-in scene with the default preset'
 settings (160 x 120, exact renders), one torch thread. A view's time is what the UAV would wait before
 flying on: measuring (the depth camera's image, or the second frames' renders and their plane sweeps) and
 scoring the 125 candidate steps on the grid. Stereo with three second frames (back, forward, up; round 26)
-is measured beside one (round 25), so the price of each added frame is a ratio from the same run.
+is measured beside one (round 25; `lookahead-stereo`), so the price of each added frame is a ratio from the
+same run; both step as `lookahead-stereo` does (forward, round 28).
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import time
 
 from common.threads import set_torch_threads
 from nbv.bench import BenchResult
-from nbv.planning.lookahead import LookaheadOptions, LookaheadPlanner
+from nbv.planning.lookahead import STEREO_FORWARD, LookaheadOptions, LookaheadPlanner
 from nbv.planning.world import PlanningWorld
 from nbv.rl.presets import default_preset
 from nbv.rl.validate import evaluation_env_config
@@ -22,10 +23,10 @@ from scenes.spec import SceneSet
 
 PLANNERS = {
     "depth camera": LookaheadPlanner(),
-    "stereo, one second frame (back)": LookaheadPlanner(depth="stereo",
-                                                        options=LookaheadOptions(partners=("back",))),
+    "stereo, one second frame (back; lookahead-stereo)": LookaheadPlanner(
+        depth="stereo", options=LookaheadOptions(forward=STEREO_FORWARD)),
     "stereo, three second frames (back, forward, up)": LookaheadPlanner(
-        depth="stereo", options=LookaheadOptions(partners=("back", "forward", "up"))),
+        depth="stereo", options=LookaheadOptions(partners=("back", "forward", "up"), forward=STEREO_FORWARD)),
 }
 """The look-aheads timed, by label."""
 

@@ -48,7 +48,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from nbv.flight.path import azimuth_step, shell_path
+from nbv.flight.path import azimuth_step, shell_path, shell_position
 from nbv.planning.base import Planner
 from nbv.planning.infogain import target_grid
 from nbv.recon.config import OccupancyConfig
@@ -84,8 +84,6 @@ STEREO_AGREE = 0
 STEREO_FORWARD = True
 """`lookahead-stereo` steps as a pilot's orbit, always forward (round 28, validation buildings: five of six
 checks, the first image-only planner to pass five; the teacher's steps either way passed four)."""
-ORIGIN = np.zeros(3)
-"""Where `crowds` puts the target's centre: distances between cameras do not depend on it."""
 PARTNER_SIDES = ("back", "forward", "up")
 """Back or forward along the view's orbit, or up its meridian."""
 DEPTH_SOURCES = ("camera", "stereo")
@@ -264,8 +262,8 @@ def revisits(view: Viewpoint, flown: list[Viewpoint], tolerance: float = 1e-6) -
 
 def crowds(view: Viewpoint, flown: list[Viewpoint], spacing_m: float) -> bool:
     """Whether `view`'s camera lies within `spacing_m` metres (a straight line) of a view `flown`'s."""
-    here = viewpoint_to_c2w(view, ORIGIN)[:3, 3]
-    return any(np.linalg.norm(here - viewpoint_to_c2w(f, ORIGIN)[:3, 3]) < spacing_m for f in flown)
+    here = shell_position(*view.as_array())
+    return any(np.linalg.norm(here - shell_position(*f.as_array())) < spacing_m for f in flown)
 
 
 def lookahead_planner(settings: PlanSettings, seed: int, argument: str | None) -> LookaheadPlanner:

@@ -16,7 +16,8 @@ unknown voxels (name ending _fK), `--allowance M --excess W` charges W a metre m
 views ahead (_HH), `--next-to-free` counts only unknown voxels beside free space (_nf); `--distinct` flies
 each look-ahead again never stepping onto a view already flown (rounds 24 and 27; name ending _d). Round 28:
 `--forward` steps as a pilot's orbit, always forward by 27.7 to 55.4 degrees (_fw). Round 29: `--spacing M`
-never steps within M metres of a camera flown (_spM).
+never steps within M metres of a camera flown (_spM). Round 30: `--sight D`
+never steps to a view whose sight line lies within D degrees of one flown's (_siD).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -78,6 +79,8 @@ def arguments() -> argparse.Namespace:
                         help="every step advances the azimuth the same way, 27.7 to 55.4 degrees")
     parser.add_argument("--spacing", type=float, default=0.0,
                         help="never step within this many metres of a camera flown (0: no rule)")
+    parser.add_argument("--sight", type=float, default=0.0,
+                        help="never step within this many degrees of a sight line flown (0: no rule)")
     looks_eval.study_arguments(parser)
     return parser.parse_args()
 
@@ -94,12 +97,14 @@ def main() -> None:
         + (f"_h{args.allowance:g}x{args.excess:g}" if args.excess else "") \
         + (f"_p{args.patience}" if args.patience else "") \
         + (f"_H{args.horizon}" if args.horizon != HORIZON else "") + ("_nf" if args.next_to_free else "") \
-        + ("_fw" if args.forward else "") + (f"_sp{args.spacing:g}" if args.spacing else "")
+        + ("_fw" if args.forward else "") + (f"_sp{args.spacing:g}" if args.spacing else "") \
+        + (f"_si{args.sight:g}" if args.sight else "")
     suffix = "_stereo" + ("" if partners == STEREO_PARTNERS else "_" + "-".join(partners)) \
         + (f"_a{args.agree}" if args.agree else "") + ("_v" if args.votes else "") + named
     options = LookaheadOptions(frontier=args.frontier, allowance_m=args.allowance, excess=args.excess,
                                patience=args.patience, horizon=args.horizon, next_to_free=args.next_to_free,
-                               forward=args.forward, spacing_m=args.spacing)
+                               forward=args.forward, spacing_m=args.spacing,
+                               sight_deg=args.sight)
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"
         for distinct in (False, True) if args.distinct else (False,):

@@ -131,6 +131,11 @@ class LookaheadOptions:
     spacing_m: float = 0.0
     """> 0: never step to a camera position within this many metres (straight line) of a view flown (once
     every step would, the rule is dropped for that step)."""
+    sight_deg: float = 0.0
+    """> 0: never step to a view whose sight line (the direction from the aim point to its camera) lies
+    within this many degrees of a view flown's, whatever its radius (once every step would, the rule is
+    dropped for that step): at 80 degrees two views share a sight line within 15 degrees up to 97.5
+    degrees of azimuth apart, so forward steps leave the top after one view (round 30)."""
 
     def __post_init__(self) -> None:
         if self.frontier < 0 or self.patience < 0 or self.horizon < 1:
@@ -139,9 +144,9 @@ class LookaheadOptions:
         if not (0 <= self.allowance_m < float("inf") and 0 <= self.excess < float("inf")):
             raise ValueError(f"lookahead's flight allowance and excess weight are finite and >= 0, got "
                              f"{self.allowance_m}, {self.excess}")
-        if not 0 <= self.spacing_m < float("inf"):
-            raise ValueError(f"lookahead's spacing is a finite distance >= 0 (0: none), got "
-                             f"{self.spacing_m}")
+        if not 0 <= self.spacing_m < float("inf") or not 0 <= self.sight_deg < 180:
+            raise ValueError(f"lookahead's spacing is a finite distance >= 0 and its sight rule 0 to 180 "
+                             f"degrees (0: none), got {self.spacing_m}, {self.sight_deg}")
         if not self.partners or not set(self.partners) <= set(PARTNER_SIDES) \
                 or not 0 <= self.agree <= len(self.partners):
             raise ValueError(f"lookahead-stereo's partners are sides from {PARTNER_SIDES} and agree 0 to "
@@ -203,10 +208,8 @@ class LookaheadPlanner(Planner):
             scores = expert_scores(view, known, sees, step, self.flight, left, options.horizon, DISCOUNT,
                                    flown_m=shell_path(chosen[0], chosen[1:]).total_m,
                                    allowance_m=options.allowance_m, excess_weight=options.excess)
-            if options.distinct or options.spacing_m:
-                nexts = [step(action, view) for action in CANDIDATES]
-                ruled = np.array([crowds(n, chosen, options.spacing_m) if options.spacing_m
-                                  else revisits(n, chosen) for n in nexts])
+            if options.distinct or options.spacing_m or options.sight_deg:
+                ruled = np.array([ruled_out(step(action, view), chosen, options) for action in CANDIDATES])
                 scores = np.where(ruled, -np.inf, scores) if not ruled.all() else scores
             view = step(best_action(scores), view)
             chosen.append(view)
@@ -264,6 +267,22 @@ def crowds(view: Viewpoint, flown: list[Viewpoint], spacing_m: float) -> bool:
     """Whether `view`'s camera lies within `spacing_m` metres (a straight line) of a view `flown`'s."""
     here = shell_position(*view.as_array())
     return any(np.linalg.norm(here - shell_position(*f.as_array())) < spacing_m for f in flown)
+
+
+def shares_sight(view: Viewpoint, flown: list[Viewpoint], degrees: float) -> bool:
+    """Whether `view`'s sight line (the unit direction from the aim point to its camera) lies within
+    `degrees` of a view `flown`'s, whatever the radii."""
+    here = shell_position(1.0, view.azimuth, view.elevation)
+    return any(np.dot(here, shell_position(1.0, f.azimuth, f.elevation)) > np.cos(np.radians(degrees))
+               for f in flown)
+
+
+def ruled_out(view: Viewpoint, flown: list[Viewpoint], options: LookaheadOptions) -> bool:
+    """Whether `options` rule a step to `view` out after the views `flown`: within `spacing_m` of one
+    (`crowds`), within `sight_deg` of one's sight line (`shares_sight`), or one of them (`distinct`)."""
+    return bool(options.spacing_m and crowds(view, flown, options.spacing_m)) \
+        or bool(options.sight_deg and shares_sight(view, flown, options.sight_deg)) \
+        or (options.distinct and revisits(view, flown))
 
 
 def lookahead_planner(settings: PlanSettings, seed: int, argument: str | None) -> LookaheadPlanner:

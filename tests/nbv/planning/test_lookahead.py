@@ -22,6 +22,7 @@ from nbv.planning.lookahead import (
     crowds,
     lookahead_planner,
     revisits,
+    shares_sight,
     stereo_partner,
 )
 from nbv.planning.registry import make_planner
@@ -134,8 +135,27 @@ def test_a_spaced_flight_never_steps_near_a_camera_flown():
     assert crowds(dear[1], dear[:1], 0.6)  # the shortest forward step lands within 0.6 m
     spaced = tiny(1e5, forward=True, spacing_m=0.6).plan(world, 4)
     assert not any(crowds(view, spaced[:i], 0.6) for i, view in enumerate(spaced) if i)
-    with pytest.raises(ValueError, match="spacing is a finite distance >= 0 .* got -0.1"):
+    with pytest.raises(ValueError, match="spacing is a finite distance >= 0 .* got -0.1, 0.0"):
         LookaheadOptions(spacing_m=-0.1)
+
+
+def test_shares_sight_measures_the_angle_between_directions_whatever_the_radius():
+    top = np.radians(80.0)  # cos(angle) = sin^2(80) + cos^2(80) cos(azimuth apart): 14.1 degrees at 90 apart
+    flown = [Viewpoint(1.5, 0.0, top)]
+    assert shares_sight(Viewpoint(2.5, np.radians(90.0), top), flown, 15.0)
+    assert not shares_sight(Viewpoint(1.5, np.radians(100.0), top), flown, 15.0)  # 15.26 degrees
+    assert shares_sight(Viewpoint(2.5, 0.0, top), flown, 0.1)  # further out on the same sight line
+    assert not shares_sight(Viewpoint(1.5, 0.0, top), [], 15.0)
+
+
+def test_a_flight_with_the_sight_rule_never_looks_along_a_sight_line_flown():
+    world = PlanningWorld(config(), seed=3)
+    dear = tiny(1e5, forward=True).plan(world, 4)
+    assert shares_sight(dear[1], dear[:1], 30.0)  # the shortest forward step turns the sight line < 30 deg
+    sighted = tiny(1e5, forward=True, sight_deg=30.0).plan(world, 4)
+    assert not any(shares_sight(view, sighted[:i], 30.0) for i, view in enumerate(sighted) if i)
+    with pytest.raises(ValueError, match="sight rule 0 to 180 degrees .* got 0.0, 180"):
+        LookaheadOptions(sight_deg=180)
 
 
 def test_a_distinct_flight_never_repeats_a_view_where_staying_put_costs_least():

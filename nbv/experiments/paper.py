@@ -365,6 +365,9 @@ INDEX = (
            "round: lookahead-stereo on a pilot's forward steps (adopted: five of six checks)", LOOKS_EVAL),
     Result("selection/round29/README.md", "selection/round29/spacing0.5/results.json", "its twenty-ninth "
            "round: forward steps that never crowd a camera flown (not adopted)", LOOKS_EVAL),
+    Result("selection/round30/README.md", "selection/round30/sight10/results.json", "its thirtieth round: "
+           "forward steps that change their sight line, alone and under a battery's hinge (not adopted)",
+           LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

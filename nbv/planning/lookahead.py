@@ -38,7 +38,10 @@ checks on the validation buildings, so they are `lookahead-stereo`'s steps (`STE
 scored once (paper_results/online/stereo): 3.9 points above the ring in 1.29x its metres, 4.3 lost with blank
 frames, 1.7 under the ring on the walled compound, where it ends its flights near-hovering at 80 degrees (a
 forward step there is an arc of 0.13 m). Round 29 (paper_results/selection/round29) never stepped within 0.25
-or 0.5 m of a camera flown (`spacing_m`): more coverage, past the metres bar, so not the default.
+or 0.5 m of a camera flown (`spacing_m`): more coverage, past the metres bar, so not the default. Round 30
+(paper_results/selection/round30) never looked along a sight line within 15 or 10 degrees of one flown
+(`sight_deg`), alone and under the teacher's hinge: past the metres bar, or the courtyard further under the
+ring than round 28's, so not the default either.
 """
 
 from __future__ import annotations

@@ -1,5 +1,6 @@
-"""`scripts/selection_frontier.py` on hand-made results: gains and metres ratios against the ring, the first
-file's figures for a planner scored twice, the counts per group, and its files."""
+"""`scripts/selection_frontier.py` on hand-made results: gains (mean and worst building) and metres ratios
+against the ring, the first file's figures for a planner scored twice, the counts per group on either axis,
+and its files."""
 
 from __future__ import annotations
 
@@ -39,10 +40,29 @@ def test_points_against_the_ring_and_counts_per_group(tmp_path, monkeypatch):
     assert points["orbit"]["group"] == "baseline"
     table = module.report(list(points.values()))
     assert "| g | 2 | 1 | 1 | 1 |" in table and "| teacher | 1 | 0 | 0 | 0 |" in table
-    assert "| g | p | +3.50 | 1.44x | 5.0 | yes |" in table
+    assert "| g | p | +3.50 | +3.00 | 1.44x | 5.0 | yes |" in table  # worst: b, 93 against 90
     (tmp_path / "1.json").write_text(json.dumps(first))
     monkeypatch.setattr(sys, "argv", ["selection_frontier.py", "--results", f"g={tmp_path / '1.json'}",
                                       "--out", str(tmp_path / "out")])
     module.main()
     assert (tmp_path / "out" / "frontier.png").stat().st_size > 0
     assert "| g | 2 | 1 | 1 | 1 |" in (tmp_path / "out" / "frontier.md").read_text()
+
+
+def test_the_worst_axis_counts_the_worst_building_against_its_bar(tmp_path, monkeypatch):
+    # p: +3.5 on the mean but 88.5 on b, 1.5 under the ring: inside on the mean's bar, not the worst's;
+    # q: +0.5 on the mean, b 0.5 under the ring: inside on the worst's bar only.
+    first = doc({"orbit": RING, "p": ([98.5, 88.5], [12.0, 12.0], [80.0, 80.0]),
+                 "q": ([91.5, 89.5], [12.0, 12.0], [80.0, 80.0])})
+    points = {p["name"]: p for p in module.frontier_points([("g", first)])}
+    assert points["p"]["worst"] == pytest.approx(-1.5) and points["q"]["worst"] == pytest.approx(-0.5)
+    assert module.inside(points["p"]) and not module.inside(points["p"], "worst")
+    assert not module.inside(points["q"]) and module.inside(points["q"], "worst")
+    assert "| g | 2 | 1 | 2 | 1 |" in module.report(list(points.values()), "worst")
+    (tmp_path / "1.json").write_text(json.dumps(first))
+    monkeypatch.setattr(sys, "argv", ["selection_frontier.py", "--results", f"g={tmp_path / '1.json'}",
+                                      "--axis", "worst", "--out", str(tmp_path / "out")])
+    module.main()
+    text = (tmp_path / "out" / "frontier.md").read_text()
+    assert "worst building's coverage over the tuned ring, points at least -1" in text
+    assert "--axis worst --out OUT" in text

@@ -115,7 +115,7 @@ PLANNERS: tuple[PlannerEntry, ...] = (
                  "view and a second frame 0.25 m back along its orbit (reads images and poses, as the "
                  "policies do), less 0.1 a metre (lookahead-stereo:W another weight)",
                  "nbv.planning.lookahead:stereo_lookahead_planner", settings=("blank_images",), argument="W",
-                 budget=False, image_option=True),
+                 prefixes=False, image_option=True),
     PlannerEntry("policy", "a trained actor (a `nbv train` checkpoint.pt or policy.pt; none: the shipped "
                  "policy) from the start view, acting on its distribution's mode",
                  "nbv.planning.policy:policy_planner", settings=("blank_images",), checkpoint=True),

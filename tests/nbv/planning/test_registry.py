@@ -92,9 +92,9 @@ def test_the_docs_list_the_registrys_planners():
 def test_the_study_lists_come_from_the_registry():
     from nbv.experiments.budget import PLANNERS, REPLANNED
 
-    assert PLANNERS == ("random", "circle", "orbit", "orbit2", "greedy", "infogain", "policy", "policy-paper",
-                        "oracle")
-    assert REPLANNED == ("circle", "orbit", "orbit2", "oracle")
+    assert PLANNERS == ("random", "circle", "orbit", "orbit2", "greedy", "infogain", "lookahead-stereo",
+                        "policy", "policy-paper", "oracle")
+    assert REPLANNED == ("circle", "orbit", "orbit2", "lookahead-stereo", "oracle")
 
 
 def test_a_registered_planner_is_in_the_help_and_plans_end_to_end(toy, tmp_path, capsys, monkeypatch):

@@ -12,6 +12,16 @@ from matplotlib.figure import Figure
 from nbv.viz.figures import save_figure
 
 
+def oracle_note(rows: Sequence[dict[str, Any]]) -> str:
+    """The title's note on the dashed oracle curve, empty where no row is the oracle's.
+
+    Example:
+        >>> oracle_note([{"planner": "orbit"}]), oracle_note([{"planner": "oracle"}])
+        ('', ' (oracle dashed: an upper bound)')
+    """
+    return " (oracle dashed: an upper bound)" if any(r["planner"] == "oracle" for r in rows) else ""
+
+
 def plot_budget_curves(rows: dict[str, Sequence[dict[str, Any]]], budgets: Sequence[int],
                        out: str | Path) -> Path:
     """Each measure (a row of panels: reconstructed, then visible coverage %) against views for every
@@ -31,7 +41,7 @@ def plot_budget_curves(rows: dict[str, Sequence[dict[str, Any]]], budgets: Seque
                    xticks=list(budgets))
             ax.grid(alpha=0.3)
             ax.legend(fontsize=7)
-    fig.suptitle("Coverage against view budget (oracle dashed: an upper bound)")
+    fig.suptitle("Coverage against view budget" + oracle_note(rows[measures[0]]))
     return save_figure(fig, out)
 
 
@@ -54,7 +64,7 @@ def plot_coverage_metres(coverage: Sequence[dict[str, Any]], metres: Sequence[di
                title=scene)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
-    fig.suptitle("Coverage against metres flown, one point per view budget (oracle dashed: an upper bound)")
+    fig.suptitle("Coverage against metres flown, one point per view budget" + oracle_note(coverage))
     return save_figure(fig, out)
 
 

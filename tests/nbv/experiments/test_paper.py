@@ -68,8 +68,8 @@ def test_tables_quick_writes_every_part_and_the_index(tmp_path):
     assert "paper Fig. 1 | 13 | 94.60 | 2.78" in episodes
     budget = json.loads((tmp_path / "budget" / "budget.json").read_text())
     rows = {r["planner"]: r for r in budget["rows"]["coverage"] if r["scene"] == "test_building"}
-    assert set(rows) == {"random", "circle", "orbit", "orbit2", "greedy", "infogain", "policy-shipped",
-                         "policy-paper", "oracle"}
+    assert set(rows) == {"random", "circle", "orbit", "orbit2", "greedy", "infogain", "lookahead-stereo",
+                         "policy-shipped", "policy-paper", "oracle"}
     for planner, row in rows.items():  # the oracle bounds the reported coverage at every budget (one seed)
         assert all(o >= m for o, m in zip(rows["oracle"]["mean"], row["mean"])), planner
     index = (tmp_path / "README.md").read_text()

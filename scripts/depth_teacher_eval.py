@@ -85,6 +85,24 @@ def arguments() -> argparse.Namespace:
     return parser.parse_args()
 
 
+def named(options: LookaheadOptions) -> str:
+    """A run's name ending for `options`' variants (rounds 27 to 30), empty for the teacher's own."""
+    o = options
+    return (f"_f{o.frontier}" if o.frontier else "") \
+        + (f"_h{o.allowance_m:g}x{o.excess:g}" if o.excess else "") \
+        + (f"_p{o.patience}" if o.patience else "") \
+        + (f"_H{o.horizon}" if o.horizon != HORIZON else "") + ("_nf" if o.next_to_free else "") \
+        + ("_fw" if o.forward else "") + (f"_sp{o.spacing_m:g}" if o.spacing_m else "") \
+        + (f"_si{o.sight_deg:g}" if o.sight_deg else "")
+
+
+def stereo_suffix(sides: LookaheadOptions) -> str:
+    """A stereo run's name ending: its second frames' sides where not `lookahead-stereo`'s, agreement,
+    votes (round 26), then `named`'s."""
+    return "_stereo" + ("" if sides.partners == STEREO_PARTNERS else "_" + "-".join(sides.partners)) \
+        + (f"_a{sides.agree}" if sides.agree else "") + ("_v" if sides.votes else "") + named(sides)
+
+
 def main() -> None:
     args = arguments()
     looks_eval.refuse_held_out(args.scenes)
@@ -92,34 +110,24 @@ def main() -> None:
     rays = max(1, trained.camera.width // args.gain_ray_stride)
     planners = {name: (make_planner(name, PlanSettings()), False) for name in ("orbit", "orbit2", "random")}
     names, blanks = [], {}
-    partners = tuple(args.partners)
-    named = (f"_f{args.frontier}" if args.frontier else "") \
-        + (f"_h{args.allowance:g}x{args.excess:g}" if args.excess else "") \
-        + (f"_p{args.patience}" if args.patience else "") \
-        + (f"_H{args.horizon}" if args.horizon != HORIZON else "") + ("_nf" if args.next_to_free else "") \
-        + ("_fw" if args.forward else "") + (f"_sp{args.spacing:g}" if args.spacing else "") \
-        + (f"_si{args.sight:g}" if args.sight else "")
-    suffix = "_stereo" + ("" if partners == STEREO_PARTNERS else "_" + "-".join(partners)) \
-        + (f"_a{args.agree}" if args.agree else "") + ("_v" if args.votes else "") + named
     options = LookaheadOptions(frontier=args.frontier, allowance_m=args.allowance, excess=args.excess,
                                patience=args.patience, horizon=args.horizon, next_to_free=args.next_to_free,
-                               forward=args.forward, spacing_m=args.spacing,
-                               sight_deg=args.sight)
+                               forward=args.forward, spacing_m=args.spacing, sight_deg=args.sight)
+    sides = replace(options, partners=tuple(args.partners), agree=args.agree, votes=args.votes)
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"
         for distinct in (False, True) if args.distinct else (False,):
             if not args.no_camera:
-                camera = name + "_d" * distinct + named
+                camera = name + "_d" * distinct + named(options)
                 planners[camera] = (LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays,
                                                      options=replace(options, distinct=distinct)), False)
                 names.append(camera)
             if args.stereo:
-                sides = replace(options, distinct=distinct, partners=partners, agree=args.agree,
-                                votes=args.votes)
                 stereo = {blank: LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays,
-                                                  depth="stereo", blank_images=blank, options=sides)
+                                                  depth="stereo", blank_images=blank,
+                                                  options=replace(sides, distinct=distinct))
                           for blank in (False, True)}
-                flown = name + suffix + "_d" * distinct
+                flown = name + stereo_suffix(sides) + "_d" * distinct
                 planners[flown], blanks[flown] = (stereo[False], False), stereo[True]
                 names.append(flown)
     results = looks_eval.evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work,

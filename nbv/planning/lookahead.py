@@ -155,6 +155,11 @@ class LookaheadOptions:
             raise ValueError(f"lookahead-stereo's partners are sides from {PARTNER_SIDES} and agree 0 to "
                              f"their number, got {self.partners}, {self.agree}")
 
+    @property
+    def masks(self) -> bool:
+        """Whether a rule (`distinct`, `spacing_m`, `sight_deg`) may rule steps out (`ruled_out`)."""
+        return bool(self.distinct or self.spacing_m or self.sight_deg)
+
 
 class LookaheadPlanner(Planner):
     """The teacher's look-ahead on an occupancy grid fused from the depth flown (module docstring)."""
@@ -211,7 +216,7 @@ class LookaheadPlanner(Planner):
             scores = expert_scores(view, known, sees, step, self.flight, left, options.horizon, DISCOUNT,
                                    flown_m=shell_path(chosen[0], chosen[1:]).total_m,
                                    allowance_m=options.allowance_m, excess_weight=options.excess)
-            if options.distinct or options.spacing_m or options.sight_deg:
+            if options.masks:
                 ruled = np.array([ruled_out(step(action, view), chosen, options) for action in CANDIDATES])
                 scores = np.where(ruled, -np.inf, scores) if not ruled.all() else scores
             view = step(best_action(scores), view)
@@ -275,9 +280,8 @@ def crowds(view: Viewpoint, flown: list[Viewpoint], spacing_m: float) -> bool:
 def shares_sight(view: Viewpoint, flown: list[Viewpoint], degrees: float) -> bool:
     """Whether `view`'s sight line (the unit direction from the aim point to its camera) lies within
     `degrees` of a view `flown`'s, whatever the radii."""
-    here = shell_position(1.0, view.azimuth, view.elevation)
-    return any(np.dot(here, shell_position(1.0, f.azimuth, f.elevation)) > np.cos(np.radians(degrees))
-               for f in flown)
+    here, least = shell_position(1.0, view.azimuth, view.elevation), np.cos(np.radians(degrees))
+    return any(np.dot(here, shell_position(1.0, f.azimuth, f.elevation)) > least for f in flown)
 
 
 def ruled_out(view: Viewpoint, flown: list[Viewpoint], options: LookaheadOptions) -> bool:

@@ -17,7 +17,8 @@ views ahead (_HH), `--next-to-free` counts only unknown voxels beside free space
 each look-ahead again never stepping onto a view already flown (rounds 24 and 27; name ending _d). Round 28:
 `--forward` steps as a pilot's orbit, always forward by 27.7 to 55.4 degrees (_fw). Round 29: `--spacing M`
 never steps within M metres of a camera flown (_spM). Round 30: `--sight D`
-never steps to a view whose sight line lies within D degrees of one flown's (_siD).
+never steps to a view whose sight line lies within D degrees of one flown's (_siD). Round 31: `--sides W`
+values each occupied voxel met from a direction it was never measured from at W unknown voxels (_sdW).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -81,19 +82,22 @@ def arguments() -> argparse.Namespace:
                         help="never step within this many metres of a camera flown (0: no rule)")
     parser.add_argument("--sight", type=float, default=0.0,
                         help="never step within this many degrees of a sight line flown (0: no rule)")
+    parser.add_argument("--sides", type=float, default=0.0,
+                        help="an occupied voxel met from a direction never measured is worth this many "
+                             "unknown voxels (0: nothing)")
     looks_eval.study_arguments(parser)
     return parser.parse_args()
 
 
 def named(options: LookaheadOptions) -> str:
-    """A run's name ending for `options`' variants (rounds 27 to 30), empty for the teacher's own."""
+    """A run's name ending for `options`' variants (rounds 27 to 31), empty for the teacher's own."""
     o = options
     return (f"_f{o.frontier}" if o.frontier else "") \
         + (f"_h{o.allowance_m:g}x{o.excess:g}" if o.excess else "") \
         + (f"_p{o.patience}" if o.patience else "") \
         + (f"_H{o.horizon}" if o.horizon != HORIZON else "") + ("_nf" if o.next_to_free else "") \
         + ("_fw" if o.forward else "") + (f"_sp{o.spacing_m:g}" if o.spacing_m else "") \
-        + (f"_si{o.sight_deg:g}" if o.sight_deg else "")
+        + (f"_si{o.sight_deg:g}" if o.sight_deg else "") + (f"_sd{o.sides:g}" if o.sides else "")
 
 
 def stereo_suffix(sides: LookaheadOptions) -> str:
@@ -112,7 +116,8 @@ def main() -> None:
     names, blanks = [], {}
     options = LookaheadOptions(frontier=args.frontier, allowance_m=args.allowance, excess=args.excess,
                                patience=args.patience, horizon=args.horizon, next_to_free=args.next_to_free,
-                               forward=args.forward, spacing_m=args.spacing, sight_deg=args.sight)
+                               forward=args.forward, spacing_m=args.spacing, sight_deg=args.sight,
+                               sides=args.sides)
     sides = replace(options, partners=tuple(args.partners), agree=args.agree, votes=args.votes)
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"

@@ -55,7 +55,7 @@ from nbv.flight.path import azimuth_step, shell_path, shell_position
 from nbv.planning.base import Planner
 from nbv.planning.infogain import target_grid
 from nbv.recon.config import OccupancyConfig
-from nbv.recon.occupancy import UNKNOWN, OccupancyGrid
+from nbv.recon.occupancy import OCCUPIED, SIGHT_BINS, UNKNOWN, OccupancyGrid
 from nbv.recon.stereo import StereoConfig, agreed_depth, box_stereo_depth, grayscale
 from nbv.rl.env import action_to_viewpoint
 from nbv.rl.expert import CANDIDATES, best_action, expert_scores
@@ -139,6 +139,11 @@ class LookaheadOptions:
     within this many degrees of a view flown's, whatever its radius (once every step would, the rule is
     dropped for that step): at 80 degrees two views share a sight line within 15 degrees up to 97.5
     degrees of azimuth apart, so forward steps leave the top after one view (round 30)."""
+    sides: float = 0.0
+    """> 0: a view also gains this much (in unknown voxels) for each occupied voxel its rays would first
+    meet from a direction it was never measured from (`OccupancyGrid.sighted`; round 31): an occupied voxel
+    holds every face of the surface in it, so the unknown-voxel gain alone cannot see that an eave's
+    underside or a parapet's inner face was never in view."""
 
     def __post_init__(self) -> None:
         if self.frontier < 0 or self.patience < 0 or self.horizon < 1:
@@ -147,6 +152,9 @@ class LookaheadOptions:
         if not (0 <= self.allowance_m < float("inf") and 0 <= self.excess < float("inf")):
             raise ValueError(f"lookahead's flight allowance and excess weight are finite and >= 0, got "
                              f"{self.allowance_m}, {self.excess}")
+        if not 0 <= self.sides < float("inf"):
+            raise ValueError(f"lookahead's weight of a side never measured is finite and >= 0, got "
+                             f"{self.sides}")
         if not 0 <= self.spacing_m < float("inf") or not 0 <= self.sight_deg < 180:
             raise ValueError(f"lookahead's spacing is a finite distance >= 0 and its sight rule 0 to 180 "
                              f"degrees (0: none), got {self.spacing_m}, {self.sight_deg}")
@@ -190,32 +198,40 @@ class LookaheadPlanner(Planner):
             else replace(world.env, action_mode="orbit", relative_step=ORBIT_STEP)
 
         seen: dict[tuple[float, float, float], np.ndarray] = {}  # this step's views (the grid is fixed)
+        voxels = grid.state.size
 
         def sees(view: Viewpoint) -> np.ndarray:
             key = (round(view.radius, 9), round(view.azimuth % (2 * np.pi), 9), round(view.elevation, 9))
             if key not in seen:
-                seen[key] = grid.reached(camera.K, viewpoint_to_c2w(view, center), camera.width,
-                                         camera.height, stride, options.frontier)
+                pose = viewpoint_to_c2w(view, center)
+                seen[key] = grid.reached(camera.K, pose, camera.width, camera.height, stride,
+                                         options.frontier)
                 if options.next_to_free:
                     seen[key] &= edge
+                if options.sides:  # then (occupied voxel, direction) items: `side_items`
+                    sighted = grid.sighted(camera.K, pose, camera.width, camera.height, stride)
+                    seen[key] = np.concatenate([seen[key], sighted[occupied].reshape(-1)])
             return seen[key]
 
         def step(action: np.ndarray, view: Viewpoint) -> Viewpoint:
             return action_to_viewpoint(action, view, steps)
 
-        view, chosen, edge = world.start, [world.start], None
-        looked = np.zeros(grid.state.size, np.uint16)  # views flown that reached each voxel, still unknown
+        view, chosen, edge, occupied = world.start, [world.start], None, None
+        looked = np.zeros(voxels, np.uint16)  # views flown that reached each voxel, still unknown
         for left in range((self.default_views if views is None else views) - 1, 0, -1):
             self.measure(world, grid, view)
             seen.clear()
             edge = grid.frontier() if options.next_to_free else None
+            occupied = np.flatnonzero(grid.state.reshape(-1) == OCCUPIED)
             known = grid.state.reshape(-1) != UNKNOWN
             if options.patience:
-                looked += sees(view)
+                looked += sees(view)[:voxels]
                 known |= looked >= options.patience
+            known, weights = side_items(grid, occupied, known, options.sides)
             scores = expert_scores(view, known, sees, step, self.flight, left, options.horizon, DISCOUNT,
                                    flown_m=shell_path(chosen[0], chosen[1:]).total_m,
-                                   allowance_m=options.allowance_m, excess_weight=options.excess)
+                                   allowance_m=options.allowance_m, excess_weight=options.excess,
+                                   weights=weights, total=voxels)
             if options.masks:
                 ruled = np.array([ruled_out(step(action, view), chosen, options) for action in CANDIDATES])
                 scores = np.where(ruled, -np.inf, scores) if not ruled.all() else scores
@@ -249,6 +265,18 @@ class LookaheadPlanner(Planner):
                                           self.options.agree)], [pose]
         for depth, at in zip(fused, views, strict=True):
             grid.integrate(depth, camera.K, at, stride)
+
+
+def side_items(grid: OccupancyGrid, occupied: np.ndarray, known: np.ndarray,
+               sides: float) -> tuple[np.ndarray, np.ndarray | None]:
+    """The look-ahead's samples with `sides` > 0: the grid's voxels (`known`), then each `occupied` voxel's
+    `SIGHT_BINS` directions, known where it has been measured from that direction (`OccupancyGrid.sides`);
+    and their worth (1 a voxel, `sides` a direction). Without, `known` and None."""
+    if not sides:
+        return known, None
+    measured = (grid.sides[occupied, None] >> np.arange(SIGHT_BINS, dtype=np.uint16)) & 1
+    weights = np.concatenate([np.ones(len(known)), np.full(measured.size, sides)])
+    return np.concatenate([known, measured.astype(bool).reshape(-1)]), weights
 
 
 def stereo_partner(view: Viewpoint, baseline: float = STEREO_BASELINE_M, side: str = "back") -> Viewpoint:

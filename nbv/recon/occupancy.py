@@ -28,6 +28,14 @@ probabilistic:
   with visibility 1 for the first k unknown voxels and 0 behind).
 - `frontier`: the unknown voxels beside free space (Yamauchi 1997), where a
   surface not yet measured can lie.
+- `sides` and `sighted`: from which of `SIGHT_BINS` directions (`sight_bin`) each
+  occupied voxel has been measured, and from which a candidate's rays would first
+  meet one. An occupied voxel holds every face of the surface inside it, so the
+  unknown-voxel gain cannot see that the underside of an eave or the inner face
+  of a parapet was never in view once the voxel is known; a hit from a new
+  direction can (the viewing directions per voxel of surface-coverage planners,
+  e.g. Vasquez-Gomez et al., "Volumetric next-best-view planning for 3D object
+  reconstruction with positioning error", IJARS 2014, kept here as 12 bins).
 
 Depth is z-depth (docs/conventions.md, `render.renderer`): a pixel's ray has
 direction (x, y, 1) in the camera frame (`render.camera.pixel_rays`), so its hit
@@ -56,6 +64,21 @@ from render.viewpoint import validate_pose
 
 UNKNOWN, FREE, OCCUPIED = 0, 1, 2
 """Voxel states."""
+SIGHT_BINS, LEVEL_SIN = 12, np.sin(np.radians(10.0))
+"""Directions a voxel is measured from: 4 horizontal quadrants, each looking up, level or down (a ray's
+vertical part beyond `LEVEL_SIN` of its length, 10 degrees)."""
+
+
+def sight_bin(directions: np.ndarray) -> np.ndarray:
+    """The bin (0 to `SIGHT_BINS` - 1) of each unit ray direction (..., 3): its horizontal quadrant (by the
+    larger of |x| and |y| and its sign) times 3, plus 0 looking down, 1 level, 2 looking up.
+
+    >>> sight_bin(np.array([[1.0, 0, 0], [0, -0.9, 0.44], [-0.6, 0.5, -0.62]])).tolist()
+    [4, 2, 6]
+    """
+    x, y, z = directions[..., 0], directions[..., 1], directions[..., 2]
+    quadrant = np.where(np.abs(x) >= np.abs(y), np.where(x >= 0, 1, 2), np.where(y >= 0, 3, 0))
+    return (3 * quadrant + (z > -LEVEL_SIN) + (z > LEVEL_SIN)).astype(np.int64)
 CHUNK_SAMPLES = 1 << 21
 """Ray samples held at once (a few arrays of 2M numbers)."""
 
@@ -82,6 +105,7 @@ class OccupancyGrid:
         self.state = np.zeros(tuple(int(n) for n in shape), dtype=np.uint8)
         self.upper = self.lower + shape * self.voxel_size
         self.votes = votes
+        self.sides = np.zeros(self.state.size, np.uint16)  # bit b: measured from `sight_bin` b
         self.hits, self.passes = (np.zeros(self.state.size if votes else 0, np.uint32) for _ in range(2))
 
     def integrate(self, depth: np.ndarray, K: np.ndarray, c2w: np.ndarray,  # noqa: N803
@@ -107,8 +131,12 @@ class OccupancyGrid:
         for index, valid in self._walk(origin, sub_rays / lengths, sub_ranges):
             crossed[index[valid]] = True
         hits = origin + rays[depth > 0] * depth[depth > 0, None]
+        inside = self.contains(hits)
         hit = np.zeros(flat.size, dtype=bool)
-        hit[self.voxel_index(hits)[self.contains(hits)]] = True
+        hit[self.voxel_index(hits)[inside]] = True
+        bins = sight_bin(rays[depth > 0][inside] / np.linalg.norm(rays[depth > 0][inside], axis=-1,
+                                                                    keepdims=True))
+        np.bitwise_or.at(self.sides, self.voxel_index(hits)[inside], (1 << bins).astype(np.uint16))
         if not self.votes:
             flat[crossed & (flat != OCCUPIED)] = FREE
             flat[hit] = OCCUPIED
@@ -145,6 +173,24 @@ class OccupancyGrid:
                 unknown &= np.cumsum(entered, axis=1) <= first
             reached[index[unknown]] = True
         return reached
+
+    def sighted(self, K: np.ndarray, c2w: np.ndarray, width: int, height: int,  # noqa: N803
+                stride: int = 1) -> np.ndarray:
+        """(voxels, `SIGHT_BINS`) bool: the occupied voxel every `stride`-th pixel's ray meets first (past
+        free and unknown voxels), in the bin of the ray's direction (`sight_bin`)."""
+        origin, rays = self._rays(K, c2w, width, height, stride)
+        rays = rays.reshape(-1, 3)
+        rays = rays / np.linalg.norm(rays, axis=-1, keepdims=True)
+        bins, flat = sight_bin(rays), self.state.reshape(-1)
+        sighted = np.zeros((flat.size, SIGHT_BINS), dtype=bool)
+        done = 0
+        for index, valid in self._walk(origin, rays, np.full(len(rays), np.inf)):
+            occupied = valid & (flat[index] == OCCUPIED)
+            met = occupied.any(axis=1)
+            first = index[np.arange(len(index)), occupied.argmax(axis=1)]
+            sighted[first[met], bins[done:done + len(index)][met]] = True
+            done += len(index)
+        return sighted
 
     def frontier(self) -> np.ndarray:
         """Which voxels (flat bool) are unknown with a free face neighbour: the frontier between the space

@@ -72,20 +72,25 @@ def candidate_actions() -> np.ndarray:
 def expert_scores(view: Viewpoint, seen: np.ndarray, sees: Callable[[Viewpoint], np.ndarray],
                   step: Callable[[np.ndarray, Viewpoint], Viewpoint], flight_weight: float,
                   views_left: int, horizon: int, discount: float, *, flown_m: float = 0.0,
-                  allowance_m: float = 0.0, excess_weight: float = 0.0) -> np.ndarray:
+                  allowance_m: float = 0.0, excess_weight: float = 0.0, weights: np.ndarray | None = None,
+                  total: int = 0) -> np.ndarray:
     """Every candidate action's score (module docstring), in `CANDIDATES`' order, from `view`, given the
     samples `seen` so far, what each view `sees`, how an action moves (`step(action, view)`), the flight-cost
     weight per metre, the views still to take, the horizon (0: all of them) and the discount (their defaults
     are `RewardConfig.teacher_horizon` and `teacher_discount`'s), and the hinge's terms (`flight_cost`:
-    metres flown so far, the allowance, the excess weight); float64 (125,), in coverage points."""
+    metres flown so far, the allowance, the excess weight); float64 (125,), in coverage points. `weights`:
+    each sample's worth (None: 1 each); `total`: the samples a coverage point is a hundredth of (0: all of
+    `seen`)."""
     horizon = max(1, min(horizon or views_left, views_left))
+    per = max(total or len(seen), 1)
     scores = np.empty(len(CANDIDATES))
     for i, action in enumerate(CANDIDATES):
         covered, here, score, flown = seen.copy(), view, 0.0, []
         for k in range(horizon):
             here = step(action, here)
             new = sees(here) & ~covered
-            score += discount ** k * TEACHER_COVERAGE * float(np.count_nonzero(new)) / max(len(seen), 1)
+            worth = np.count_nonzero(new) if weights is None else weights[new].sum()
+            score += discount ** k * TEACHER_COVERAGE * float(worth) / per
             covered |= new
             flown.append(here)
         legs = shell_path(view, flown).legs_m

@@ -122,6 +122,17 @@ def test_forward_steps_always_advance_the_azimuth_one_way_and_a_dear_flight_take
     assert np.degrees(azimuth_step(world.start.azimuth, dear[1].azimuth)) == pytest.approx(360 / 13)
 
 
+def test_valuing_unmeasured_sides_changes_a_looking_flight_but_not_a_blind_one():
+    world = PlanningWorld(config(), seed=3)
+    plain = tiny(0.0, forward=True).plan(world, 4)
+    assert tiny(0.0, forward=True, sides=0.0).plan(world, 4) == plain
+    assert tiny(0.0, forward=True, sides=50.0).plan(world, 4) != plain  # occupied voxels seen from new sides
+    blind = tiny(0.0, "stereo", True, forward=True).plan(world, 3)
+    assert tiny(0.0, "stereo", True, forward=True, sides=50.0).plan(world, 3) == blind  # nothing measured
+    with pytest.raises(ValueError, match="weight of a side never measured is finite and >= 0, got -1"):
+        LookaheadOptions(sides=-1)
+
+
 def test_crowds_measures_the_straight_line_between_cameras():
     flown = [Viewpoint(1.0, 0.0, 0.0)]
     assert crowds(Viewpoint(1.0, np.pi / 3, 0.0), flown, 1.01)  # a 60-degree chord of a 1 m orbit: 1 m

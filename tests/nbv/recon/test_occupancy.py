@@ -7,7 +7,7 @@ import open3d as o3d
 import pytest
 import trimesh
 
-from nbv.recon.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from nbv.recon.occupancy import FREE, OCCUPIED, SIGHT_BINS, UNKNOWN, OccupancyGrid, sight_bin
 from render.camera import UAVCamera
 from render.raycast import DepthRaycaster
 from render.renderer import MitsubaRenderer
@@ -91,6 +91,27 @@ def test_first_counts_only_each_rays_first_unknown_voxels():
     assert grid.gain(ONE_PIXEL, ALONG_X, 1, 1, first=0) == 1  # free voxels let the ray on and count nothing
     with pytest.raises(ValueError, match="first unknown voxels to count must be >= 0"):
         grid.reached(ONE_PIXEL, ALONG_X, 1, 1, first=-1)
+
+
+def test_sight_bins_split_quadrants_and_looking_up_level_or_down_at_10_degrees():
+    up, down = np.sin(np.radians(10.5)), np.sin(np.radians(9.5))
+    bins = sight_bin(np.array([[0, -1.0, 0], [1.0, 0, 0], [-1.0, 0, 0], [0, 1.0, 0],
+                               [np.sqrt(1 - up ** 2), 0, up], [np.sqrt(1 - down ** 2), 0, down],
+                               [np.sqrt(1 - up ** 2), 0, -up]]))
+    assert bins.tolist() == [1, 4, 7, 10, 5, 4, 3]  # -y, +x, -x, +y quadrants level; then +x up, level, down
+    assert SIGHT_BINS == 12
+
+
+def test_sides_record_the_direction_a_hit_was_measured_from_and_sighted_names_new_ones():
+    grid = row_of_four()
+    assert not grid.sighted(ONE_PIXEL, ALONG_X, 1, 1).any()  # nothing occupied: nothing met
+    grid.integrate(np.array([[3.5]], np.float32), ONE_PIXEL, ALONG_X)  # voxel 2 hit looking +x, level
+    assert grid.sides[:4].tolist() == [0, 0, 1 << 4, 0]
+    along, against = (grid.sighted(ONE_PIXEL, pose, 1, 1) for pose in (ALONG_X, AGAINST_X))
+    assert along.shape == (4, SIGHT_BINS) and np.argwhere(along).tolist() == [[2, 4]]  # its own side again
+    assert np.argwhere(against).tolist() == [[2, 7]]  # past unknown voxel 3, voxel 2 from -x: a new side
+    grid.integrate(np.array([[0.0]], np.float32), ONE_PIXEL, AGAINST_X)  # no hit marks no side
+    assert grid.sides[:4].tolist() == [0, 0, 1 << 4, 0]
 
 
 def test_the_frontier_is_the_unknown_beside_free_space():

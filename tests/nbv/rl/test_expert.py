@@ -219,3 +219,14 @@ def test_the_near_tie_distance_is_to_the_nearest_tie():
 def test_a_negative_tolerance_is_refused():
     with pytest.raises(ValueError, match="teacher_tolerance must be finite and >= 0"):
         RewardConfig(teacher_tolerance=-0.1)
+
+
+def test_weighted_samples_count_their_worth_over_the_total_given():
+    # Two samples every view sees at once, none seen yet: 100 x 2 / 2 points at the first view (later views
+    # see nothing new), less a tie-break of 1e-6 a metre. Worth 1 and 0.5 over a total of 1: 150 points.
+    both = lambda view: np.ones(2, bool)  # noqa: E731
+    plain = expert_scores(START, np.zeros(2, bool), both, step, 0.0, 12, **TEACHER)
+    weighted = expert_scores(START, np.zeros(2, bool), both, step, 0.0, 12, **TEACHER,
+                             weights=np.array([1.0, 0.5]), total=1)
+    assert plain == pytest.approx(np.full(125, 100.0), abs=1e-4)
+    assert weighted == pytest.approx(plain + 50.0, abs=1e-9)

@@ -372,6 +372,9 @@ INDEX = (
     Result("selection/round30/README.md", "selection/round30/sight10/results.json", "its thirtieth round: "
            "forward steps that change their sight line, alone and under a battery's hinge (not adopted)",
            LOOKS_EVAL),
+    Result("selection/round31/README.md", "selection/round31/sides1/results.json", "its thirty-first round: "
+           "the look-ahead values the sides of surface it never measured from (OccupancyGrid.sides)",
+           LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

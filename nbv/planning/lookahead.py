@@ -87,6 +87,14 @@ STEREO_AGREE = 0
 STEREO_FORWARD = True
 """`lookahead-stereo` steps as a pilot's orbit, always forward (round 28, validation buildings: five of six
 checks, the first image-only planner to pass five; the teacher's steps either way passed four)."""
+STEREO_SIDES = 1.0
+"""`lookahead-stereo`'s worth of an occupied voxel met from a direction never measured, in unknown voxels
+(`LookaheadOptions.sides`; round 31, validation buildings: with `STEREO_HINGE` five of six checks, the worst
+building 0.4 under the ring against round 28's 0.6)."""
+STEREO_HINGE = (13.0, 2.0)
+"""`lookahead-stereo`'s battery hinge: metres of flight, then coverage points a metre more (`allowance_m`,
+`excess`; round 31: without it the sides term flew 1.57x the ring's metres, with it 1.44x). Metres along the
+viewing shell of the default preset's ranges (the tuned ring flies 9.0 m)."""
 PARTNER_SIDES = ("back", "forward", "up")
 """Back or forward along the view's orbit, or up its meridian."""
 DEPTH_SOURCES = ("camera", "stereo")
@@ -329,10 +337,12 @@ def lookahead_planner(settings: PlanSettings, seed: int, argument: str | None) -
 
 def stereo_lookahead_planner(settings: PlanSettings, seed: int, argument: str | None) -> LookaheadPlanner:
     """The registry's `lookahead-stereo`: the look-ahead on stereo depth from two frames a view, on forward
-    steps (the validated weight, or `lookahead-stereo:W`)."""
+    steps, valuing sides never measured, under a battery's hinge (the validated weight, or
+    `lookahead-stereo:W`)."""
     flight = STEREO_FLIGHT if argument is None else flight_weight(argument)
     return LookaheadPlanner(flight=flight, depth="stereo", blank_images=settings.blank_images,
-                            options=LookaheadOptions(forward=STEREO_FORWARD))
+                            options=LookaheadOptions(forward=STEREO_FORWARD, sides=STEREO_SIDES,
+                                                     allowance_m=STEREO_HINGE[0], excess=STEREO_HINGE[1]))
 
 
 def flight_weight(argument: str) -> float:

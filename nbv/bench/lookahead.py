@@ -4,8 +4,9 @@ Each planner flies the same views on the built-in scene with the default preset'
 settings (160 x 120, exact renders), one torch thread. A view's time is what the UAV would wait before
 flying on: measuring (the depth camera's image, or the second frames' renders and their plane sweeps) and
 scoring the 125 candidate steps on the grid. Stereo with three second frames (back, forward, up; round 26)
-is measured beside one (round 25; `lookahead-stereo`), so the price of each added frame is a ratio from the
-same run; both step as `lookahead-stereo` does (forward, round 28).
+is measured beside one (round 25), so the price of each added frame is a ratio from the same run; both step
+forward (round 28). `lookahead-stereo` itself (one frame, forward, valuing sides never measured under a
+battery's hinge; round 31) is timed beside round 28's setting, so the sides term's price is a ratio too.
 """
 
 from __future__ import annotations
@@ -14,7 +15,13 @@ import time
 
 from common.threads import set_torch_threads
 from nbv.bench import BenchResult
-from nbv.planning.lookahead import STEREO_FORWARD, LookaheadOptions, LookaheadPlanner
+from nbv.planning.config import PlanSettings
+from nbv.planning.lookahead import (
+    STEREO_FORWARD,
+    LookaheadOptions,
+    LookaheadPlanner,
+    stereo_lookahead_planner,
+)
 from nbv.planning.world import PlanningWorld
 from nbv.rl.presets import default_preset
 from nbv.rl.validate import evaluation_env_config
@@ -23,8 +30,10 @@ from scenes.spec import SceneSet
 
 PLANNERS = {
     "depth camera": LookaheadPlanner(),
-    "stereo, one second frame (back; lookahead-stereo)": LookaheadPlanner(
+    "stereo, one second frame (back; round 28's setting)": LookaheadPlanner(
         depth="stereo", options=LookaheadOptions(forward=STEREO_FORWARD)),
+    "lookahead-stereo (one frame, sides never measured, hinge; round 31)": stereo_lookahead_planner(
+        PlanSettings(), 0, None),
     "stereo, three second frames (back, forward, up)": LookaheadPlanner(
         depth="stereo", options=LookaheadOptions(partners=("back", "forward", "up"), forward=STEREO_FORWARD)),
 }
@@ -43,13 +52,16 @@ def seconds_a_view(planner: LookaheadPlanner, views: int) -> float:
 
 
 def run(quick: bool) -> list[BenchResult]:
-    """Seconds a view of each look-ahead, and the stereo ones' ratios to the depth camera's and each other."""
+    """Seconds a view of each look-ahead, and the stereo ones' ratios to the depth camera's and each other
+    (the sides term's price: `lookahead-stereo` over round 28's setting)."""
     set_torch_threads(1)
     views = 3 if quick else 9
     seconds = {label: seconds_a_view(planner, views) for label, planner in PLANNERS.items()}
     results = [BenchResult("lookahead", f"{label}: s/view to choose the next, 160x120", value, "s")
                for label, value in seconds.items()]
-    camera, one, three = seconds.values()
+    camera, one, sides, three = seconds.values()
     results.append(BenchResult("lookahead", "stereo (one frame) / depth camera", one / camera, "x"))
     results.append(BenchResult("lookahead", "stereo three frames / one frame", three / one, "x"))
+    results.append(BenchResult("lookahead", "lookahead-stereo (sides) / round 28's setting", sides / one,
+                               "x"))
     return results

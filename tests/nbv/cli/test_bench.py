@@ -29,7 +29,8 @@ def test_bench_times_the_look_aheads_side_by_side(tmp_path):
     assert main(["bench", "--quick", "--area", "lookahead", "--out", str(tmp_path)]) == 0
     results = {r["name"]: r for r in json.loads((tmp_path / "bench.json").read_text())["results"]}
     seconds = [r["value"] for r in results.values() if r["unit"] == "s"]
-    assert len(seconds) == 3 and all(s > 0 for s in seconds)
+    assert len(seconds) == 4 and all(s > 0 for s in seconds)
     three = results["stereo three frames / one frame"]["value"]
     assert three > 1.0  # two more renders and sweeps a view cost time
+    assert results["lookahead-stereo (sides) / round 28's setting"]["value"] > 0
 

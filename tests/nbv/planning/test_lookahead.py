@@ -17,6 +17,8 @@ from nbv.planning.lookahead import (
     LOOKAHEAD_FLIGHT,
     STEREO_BASELINE_M,
     STEREO_FLIGHT,
+    STEREO_HINGE,
+    STEREO_SIDES,
     LookaheadOptions,
     LookaheadPlanner,
     crowds,
@@ -270,7 +272,9 @@ def test_stereo_measures_the_building_and_blank_frames_measure_nothing():
     assert views[0] == small.start and len(views) == 3
     stereo = make_planner("lookahead-stereo", PlanSettings())
     assert (stereo.name, stereo.flight, stereo.depth) == ("lookahead-stereo", STEREO_FLIGHT, "stereo")
-    assert stereo.options == LookaheadOptions(forward=True)
+    assert stereo.options == LookaheadOptions(forward=True, sides=STEREO_SIDES, allowance_m=STEREO_HINGE[0],
+                                              excess=STEREO_HINGE[1])
+    assert STEREO_HINGE == (13.0, 2.0) and STEREO_SIDES == 1.0  # round 31's setting
     assert make_planner("lookahead-stereo:0.2", PlanSettings(blank_images=True)).blank_images
     with pytest.raises(ValueError, match="depth from"):
         LookaheadPlanner(depth="lidar")

@@ -100,11 +100,11 @@ def named(options: LookaheadOptions) -> str:
         + (f"_si{o.sight_deg:g}" if o.sight_deg else "") + (f"_sd{o.sides:g}" if o.sides else "")
 
 
-def stereo_suffix(sides: LookaheadOptions) -> str:
+def stereo_suffix(paired: LookaheadOptions) -> str:
     """A stereo run's name ending: its second frames' sides where not `lookahead-stereo`'s, agreement,
     votes (round 26), then `named`'s."""
-    return "_stereo" + ("" if sides.partners == STEREO_PARTNERS else "_" + "-".join(sides.partners)) \
-        + (f"_a{sides.agree}" if sides.agree else "") + ("_v" if sides.votes else "") + named(sides)
+    return "_stereo" + ("" if paired.partners == STEREO_PARTNERS else "_" + "-".join(paired.partners)) \
+        + (f"_a{paired.agree}" if paired.agree else "") + ("_v" if paired.votes else "") + named(paired)
 
 
 def main() -> None:
@@ -118,7 +118,7 @@ def main() -> None:
                                patience=args.patience, horizon=args.horizon, next_to_free=args.next_to_free,
                                forward=args.forward, spacing_m=args.spacing, sight_deg=args.sight,
                                sides=args.sides)
-    sides = replace(options, partners=tuple(args.partners), agree=args.agree, votes=args.votes)
+    paired = replace(options, partners=tuple(args.partners), agree=args.agree, votes=args.votes)
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"
         for distinct in (False, True) if args.distinct else (False,):
@@ -130,9 +130,9 @@ def main() -> None:
             if args.stereo:
                 stereo = {blank: LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays,
                                                   depth="stereo", blank_images=blank,
-                                                  options=replace(sides, distinct=distinct))
+                                                  options=replace(paired, distinct=distinct))
                           for blank in (False, True)}
-                flown = name + stereo_suffix(sides) + "_d" * distinct
+                flown = name + stereo_suffix(paired) + "_d" * distinct
                 planners[flown], blanks[flown] = (stereo[False], False), stereo[True]
                 names.append(flown)
     results = looks_eval.evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work,

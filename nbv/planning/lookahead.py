@@ -216,13 +216,11 @@ class LookaheadPlanner(Planner):
         def sees(view: Viewpoint) -> np.ndarray:
             key = (round(view.radius, 9), round(view.azimuth % (2 * np.pi), 9), round(view.elevation, 9))
             if key not in seen:
-                pose = viewpoint_to_c2w(view, center)
-                seen[key] = grid.reached(camera.K, pose, camera.width, camera.height, stride,
-                                         options.frontier)
+                seen[key], sighted = grid.look(camera.K, viewpoint_to_c2w(view, center), camera.width,
+                                               camera.height, stride, options.frontier, bool(options.sides))
                 if options.next_to_free:
                     seen[key] &= edge
                 if options.sides:  # then (occupied voxel, direction) items: `side_items`
-                    sighted = grid.sighted(camera.K, pose, camera.width, camera.height, stride)
                     seen[key] = np.concatenate([seen[key], sighted[occupied].reshape(-1)])
             return seen[key]
 
@@ -235,7 +233,7 @@ class LookaheadPlanner(Planner):
             self.measure(world, grid, view)
             seen.clear()
             edge = grid.frontier() if options.next_to_free else None
-            occupied = np.flatnonzero(grid.state.reshape(-1) == OCCUPIED)
+            occupied = np.flatnonzero(grid.state.reshape(-1) == OCCUPIED) if options.sides else None
             known = grid.state.reshape(-1) != UNKNOWN
             if options.patience:
                 looked += sees(view)[:voxels]

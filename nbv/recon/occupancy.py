@@ -67,6 +67,8 @@ UNKNOWN, FREE, OCCUPIED = 0, 1, 2
 SIGHT_BINS, LEVEL_SIN = 12, np.sin(np.radians(10.0))
 """Directions a voxel is measured from: 4 horizontal quadrants, each looking up, level or down (a ray's
 vertical part beyond `LEVEL_SIN` of its length, 10 degrees)."""
+CHUNK_SAMPLES = 1 << 21
+"""Ray samples held at once (a few arrays of 2M numbers)."""
 
 
 def sight_bin(directions: np.ndarray) -> np.ndarray:
@@ -79,8 +81,6 @@ def sight_bin(directions: np.ndarray) -> np.ndarray:
     x, y, z = directions[..., 0], directions[..., 1], directions[..., 2]
     quadrant = np.where(np.abs(x) >= np.abs(y), np.where(x >= 0, 1, 2), np.where(y >= 0, 3, 0))
     return (3 * quadrant + (z > -LEVEL_SIN) + (z > LEVEL_SIN)).astype(np.int64)
-CHUNK_SAMPLES = 1 << 21
-"""Ray samples held at once (a few arrays of 2M numbers)."""
 
 
 class OccupancyGrid:
@@ -132,11 +132,11 @@ class OccupancyGrid:
             crossed[index[valid]] = True
         hits = origin + rays[depth > 0] * depth[depth > 0, None]
         inside = self.contains(hits)
+        voxels, toward = self.voxel_index(hits[inside]), rays[depth > 0][inside]
         hit = np.zeros(flat.size, dtype=bool)
-        hit[self.voxel_index(hits)[inside]] = True
-        bins = sight_bin(rays[depth > 0][inside] / np.linalg.norm(rays[depth > 0][inside], axis=-1,
-                                                                    keepdims=True))
-        np.bitwise_or.at(self.sides, self.voxel_index(hits)[inside], (1 << bins).astype(np.uint16))
+        hit[voxels] = True
+        bins = sight_bin(toward / np.linalg.norm(toward, axis=-1, keepdims=True))
+        np.bitwise_or.at(self.sides, voxels, (1 << bins).astype(np.uint16))
         if not self.votes:
             flat[crossed & (flat != OCCUPIED)] = FREE
             flat[hit] = OCCUPIED
@@ -157,40 +157,41 @@ class OccupancyGrid:
         """Which voxels (flat bool, the grid's size) are unknown and reached by every `stride`-th pixel's ray
         before an occupied voxel, with `first` > 0 only among the first that many unknown voxels of each
         ray: the voxels `gain` counts."""
-        if first < 0:
-            raise ValueError(f"a ray's first unknown voxels to count must be >= 0 (0: all), got {first}")
-        origin, rays = self._rays(K, c2w, width, height, stride)
-        rays = rays.reshape(-1, 3)
-        flat = self.state.reshape(-1)
-        reached = np.zeros(flat.size, dtype=bool)
-        for index, valid in self._walk(origin, rays / np.linalg.norm(rays, axis=-1, keepdims=True),
-                                       np.full(len(rays), np.inf)):
-            state = flat[index]
-            blocked = np.logical_or.accumulate(valid & (state == OCCUPIED), axis=1)
-            unknown = valid & ~blocked & (state == UNKNOWN)
-            if first:  # a sample starts a voxel where its index differs from the sample before it
-                entered = unknown & np.diff(index, axis=1, prepend=-1).astype(bool)
-                unknown &= np.cumsum(entered, axis=1) <= first
-            reached[index[unknown]] = True
-        return reached
+        return self.look(K, c2w, width, height, stride, first)[0]
 
     def sighted(self, K: np.ndarray, c2w: np.ndarray, width: int, height: int,  # noqa: N803
                 stride: int = 1) -> np.ndarray:
         """(voxels, `SIGHT_BINS`) bool: the occupied voxel every `stride`-th pixel's ray meets first (past
         free and unknown voxels), in the bin of the ray's direction (`sight_bin`)."""
+        return self.look(K, c2w, width, height, stride, sides=True)[1]
+
+    def look(self, K: np.ndarray, c2w: np.ndarray, width: int, height: int,  # noqa: N803
+             stride: int = 1, first: int = 0, sides: bool = False) -> tuple[np.ndarray, np.ndarray | None]:
+        """`reached` and, with `sides`, `sighted` (else None) from one walk of the rays."""
+        if first < 0:
+            raise ValueError(f"a ray's first unknown voxels to count must be >= 0 (0: all), got {first}")
         origin, rays = self._rays(K, c2w, width, height, stride)
         rays = rays.reshape(-1, 3)
         rays = rays / np.linalg.norm(rays, axis=-1, keepdims=True)
-        bins, flat = sight_bin(rays), self.state.reshape(-1)
-        sighted = np.zeros((flat.size, SIGHT_BINS), dtype=bool)
-        done = 0
+        flat = self.state.reshape(-1)
+        reached = np.zeros(flat.size, dtype=bool)
+        sighted = np.zeros((flat.size, SIGHT_BINS), dtype=bool) if sides else None
+        bins, done = sight_bin(rays) if sides else None, 0
         for index, valid in self._walk(origin, rays, np.full(len(rays), np.inf)):
-            occupied = valid & (flat[index] == OCCUPIED)
-            met = occupied.any(axis=1)
-            first = index[np.arange(len(index)), occupied.argmax(axis=1)]
-            sighted[first[met], bins[done:done + len(index)][met]] = True
+            state = flat[index]
+            occupied = valid & (state == OCCUPIED)
+            blocked = np.logical_or.accumulate(occupied, axis=1)
+            unknown = valid & ~blocked & (state == UNKNOWN)
+            if first:  # a sample starts a voxel where its index differs from the sample before it
+                entered = unknown & np.diff(index, axis=1, prepend=-1).astype(bool)
+                unknown &= np.cumsum(entered, axis=1) <= first
+            reached[index[unknown]] = True
+            if sides and index.shape[1]:  # a chunk whose rays all miss the box has no samples
+                met = occupied.any(axis=1)
+                meets = index[np.arange(len(index)), occupied.argmax(axis=1)]
+                sighted[meets[met], bins[done:done + len(index)][met]] = True
             done += len(index)
-        return sighted
+        return reached, sighted
 
     def frontier(self) -> np.ndarray:
         """Which voxels (flat bool) are unknown with a free face neighbour: the frontier between the space

@@ -61,6 +61,26 @@ def test_a_policy_that_passes_every_check_but_random_on_one_building_unless_the_
     assert "| **every check** |  | **yes** |" in text
 
 
+def test_without_the_oracle_a_building_random_views_nearly_cover_is_excused_at_99_percent():
+    # Random views cover 97 % of B: any oracle is under 6 points above them (it is at most 100 %), so a
+    # policy at 99.2 % is within 1 point of it; at 98.5 % it may not be, so it is held to +5 there.
+    high = {**BASELINES, "random": planner((0.78, 0.78), (0.97, 0.97), flight_m=30.0)}
+    excused = {"A": POLICY["A"], "B": [run(0, 0.992, 12.0, 1.5), run(1, 0.992, 12.0, 1.5)]}
+    check = by_check(acceptance_checks(study({"policy-shipped": excused, **high}), BLANK,
+                                       ["policy-shipped"])["policy-shipped"])["worst building minus random"]
+    assert check["passed"] and check["value"] == pytest.approx(7.0)  # A alone: 85 - 78
+    held = {"A": POLICY["A"], "B": [run(0, 0.985, 12.0, 1.5), run(1, 0.985, 12.0, 1.5)]}
+    check = by_check(acceptance_checks(study({"policy-shipped": held, **high}), BLANK,
+                                       ["policy-shipped"])["policy-shipped"])["worst building minus random"]
+    assert not check["passed"] and check["value"] == pytest.approx(1.5)  # B: 98.5 - 97
+    # Where the oracle clause excuses every building, the value is the worst of all and the check passes.
+    both = study({"policy-shipped": planner((0.992, 0.992), (0.992, 0.992)), **high,
+                  "random": planner((0.97, 0.97), (0.98, 0.98))})
+    check = by_check(acceptance_checks(both, BLANK, ["policy-shipped"])["policy-shipped"])[
+        "worst building minus random"]
+    assert check["passed"] and check["value"] == pytest.approx(1.2)
+
+
 def test_missing_planners_fail_their_checks_by_name():
     runs = study({"policy-shipped": POLICY, "random": BASELINES["random"]})
     checks = acceptance_checks(runs, None, ["policy-shipped"])

@@ -340,12 +340,27 @@ def lookahead_planner(settings: PlanSettings, seed: int, argument: str | None) -
 
 def stereo_lookahead_planner(settings: PlanSettings, seed: int, argument: str | None) -> LookaheadPlanner:
     """The registry's `lookahead-stereo`: the look-ahead on stereo depth from two frames a view, on forward
-    steps, valuing sides never measured, under a battery's hinge (the validated weight, or
-    `lookahead-stereo:W`)."""
-    flight = STEREO_FLIGHT if argument is None else flight_weight(argument)
+    steps, valuing sides never measured, under a battery's hinge: the validated setting, or
+    `lookahead-stereo:W` another flight weight, `lookahead-stereo:W,M` (or `:,M`) a battery of M metres
+    before the hinge instead of `STEREO_HINGE`'s."""
+    weight, comma, battery = (argument or "").partition(",")
+    flight = flight_weight(weight) if weight else STEREO_FLIGHT
+    allowance = battery_metres(battery) if comma else STEREO_HINGE[0]
     return LookaheadPlanner(flight=flight, depth="stereo", blank_images=settings.blank_images,
                             options=LookaheadOptions(forward=STEREO_FORWARD, sides=STEREO_SIDES,
-                                                     allowance_m=STEREO_HINGE[0], excess=STEREO_HINGE[1]))
+                                                     allowance_m=allowance, excess=STEREO_HINGE[1]))
+
+
+def battery_metres(argument: str) -> float:
+    """The metres of flight before the battery's hinge that `lookahead-stereo:W,M` gives (M > 0)."""
+    try:
+        metres = float(argument)
+    except ValueError:
+        metres = float("nan")
+    if not 0 < metres < float("inf"):
+        raise ValueError(f"lookahead-stereo:W,M takes a battery of M > 0 metres before the hinge, got "
+                         f"{argument!r}")
+    return metres
 
 
 def flight_weight(argument: str) -> float:

@@ -25,6 +25,7 @@ from nbv.planning.lookahead import (
     lookahead_planner,
     revisits,
     shares_sight,
+    stereo_lookahead_planner,
     stereo_partner,
 )
 from nbv.planning.registry import make_planner
@@ -196,6 +197,14 @@ def test_the_spec_sets_the_flight_weight_and_refuses_bad_ones():
         lookahead_planner(PlanSettings(), 0, "fast")
     with pytest.raises(ValueError, match="finite flight weight >= 0"):
         lookahead_planner(PlanSettings(), 0, "-1")
+    battery = make_planner("lookahead-stereo:0.2,20", PlanSettings())
+    assert (battery.flight, battery.options.allowance_m, battery.options.excess) == (0.2, 20, STEREO_HINGE[1])
+    battery = make_planner("lookahead-stereo:,9.5", PlanSettings())
+    assert (battery.flight, battery.options.allowance_m) == (STEREO_FLIGHT, 9.5)
+    assert make_planner("lookahead-stereo:0.2", PlanSettings()).options.allowance_m == STEREO_HINGE[0]
+    for bad in ("0.1,0", "0.1,-3", "0.1,far", "0.1,inf", "0.1,"):
+        with pytest.raises(ValueError, match=f"battery of M > 0 metres before the hinge, got '{bad[4:]}'"):
+            stereo_lookahead_planner(PlanSettings(), 0, bad)
     with pytest.raises(ValueError, match="grid >= 1, rays >= 1 and depth from .* got 0.07, 48, 0, 'camera'"):
         LookaheadPlanner(rays=0)
     with pytest.raises(ValueError, match="counts >= 0 .* got -1, 0, 3"):

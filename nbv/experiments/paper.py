@@ -375,6 +375,8 @@ INDEX = (
     Result("selection/round31/README.md", "selection/round31/sides1/results.json", "its thirty-first round: "
            "the look-ahead values the sides of surface it never measured from (OccupancyGrid.sides)",
            LOOKS_EVAL),
+    Result("selection/round32/README.md", "selection/round32/battery20/results.json", "its thirty-second "
+           "round: what a 20 m battery buys lookahead-stereo at 20 views (informational)", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

@@ -353,19 +353,21 @@ def stereo_lookahead_planner(settings: PlanSettings, seed: int, argument: str | 
 
 def battery_metres(argument: str) -> float:
     """The metres of flight before the battery's hinge that `lookahead-stereo:W,M` gives (M > 0)."""
-    try:
-        metres = float(argument)
-    except ValueError:
-        metres = float("nan")
+    usage = "lookahead-stereo:W,M takes a battery of M > 0 metres before the hinge"
+    metres = spec_number(argument, usage)
     if not 0 < metres < float("inf"):
-        raise ValueError(f"lookahead-stereo:W,M takes a battery of M > 0 metres before the hinge, got "
-                         f"{argument!r}")
+        raise ValueError(f"{usage}, got {argument!r}")
     return metres
 
 
 def flight_weight(argument: str) -> float:
     """The flight weight a metre that `lookahead:W` gives."""
+    return spec_number(argument, "lookahead:W takes a flight weight a metre")
+
+
+def spec_number(argument: str, usage: str) -> float:
+    """A planner spec's number, or a ValueError saying `usage` and what was given."""
     try:
         return float(argument)
     except ValueError:
-        raise ValueError(f"lookahead:W takes a flight weight a metre, got {argument!r}") from None
+        raise ValueError(f"{usage}, got {argument!r}") from None

@@ -19,6 +19,7 @@ each look-ahead again never stepping onto a view already flown (rounds 24 and 27
 never steps within M metres of a camera flown (_spM). Round 30: `--sight D`
 never steps to a view whose sight line lies within D degrees of one flown's (_siD). Round 31: `--sides W`
 values each occupied voxel met from a direction it was never measured from at W unknown voxels (_sdW).
+Round 33: `--per-view P` grows the battery to P metres a view where that passes --allowance (_pvP).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -71,6 +72,8 @@ def arguments() -> argparse.Namespace:
                         help="metres of the flight before --excess a metre more is charged")
     parser.add_argument("--excess", type=float, default=0.0,
                         help="coverage points a metre charged past --allowance (0: no hinge)")
+    parser.add_argument("--per-view", type=float, default=0.0,
+                        help="the battery grows to this many metres a view where that passes --allowance")
     parser.add_argument("--patience", type=int, default=0,
                         help="an unknown voxel that many views flown reached unmeasured counts as seen")
     parser.add_argument("--horizon", type=int, default=HORIZON, help="views scored ahead of each step")
@@ -90,10 +93,11 @@ def arguments() -> argparse.Namespace:
 
 
 def named(options: LookaheadOptions) -> str:
-    """A run's name ending for `options`' variants (rounds 27 to 31), empty for the teacher's own."""
+    """A run's name ending for `options`' variants (rounds 27 to 33), empty for the teacher's own."""
     o = options
     return (f"_f{o.frontier}" if o.frontier else "") \
         + (f"_h{o.allowance_m:g}x{o.excess:g}" if o.excess else "") \
+        + (f"_pv{o.battery_per_view_m:g}" if o.battery_per_view_m else "") \
         + (f"_p{o.patience}" if o.patience else "") \
         + (f"_H{o.horizon}" if o.horizon != HORIZON else "") + ("_nf" if o.next_to_free else "") \
         + ("_fw" if o.forward else "") + (f"_sp{o.spacing_m:g}" if o.spacing_m else "") \
@@ -117,7 +121,7 @@ def main() -> None:
     options = LookaheadOptions(frontier=args.frontier, allowance_m=args.allowance, excess=args.excess,
                                patience=args.patience, horizon=args.horizon, next_to_free=args.next_to_free,
                                forward=args.forward, spacing_m=args.spacing, sight_deg=args.sight,
-                               sides=args.sides)
+                               sides=args.sides, battery_per_view_m=args.per_view)
     paired = replace(options, partners=tuple(args.partners), agree=args.agree, votes=args.votes)
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"

@@ -100,6 +100,9 @@ STEREO_HINGE = (13.0, 2.0)
 """`lookahead-stereo`'s battery hinge: metres of flight, then coverage points a metre more (`allowance_m`,
 `excess`; round 31: without it the sides term flew 1.57x the ring's metres, with it 1.44x). Metres along the
 viewing shell of the default preset's ranges (the tuned ring flies 9.0 m)."""
+STEREO_PER_VIEW = 0.0
+"""`lookahead-stereo`'s battery a view where that passes `STEREO_HINGE`'s metres (`battery_per_view_m`; 0:
+the battery stays 13 m whatever the views; round 33 on the validation buildings decides)."""
 PARTNER_SIDES = ("back", "forward", "up")
 """Back or forward along the view's orbit, or up its meridian."""
 DEPTH_SOURCES = ("camera", "stereo")
@@ -132,6 +135,9 @@ class LookaheadOptions:
     `nbv.rl.flight_cost`)."""
     excess: float = 0.0
     """Coverage points a metre more for the flight past `allowance_m`."""
+    battery_per_view_m: float = 0.0
+    """> 0: the battery grows with the view budget, to this many metres a view where that passes
+    `allowance_m` (`battery`)."""
     patience: int = 0
     """n > 0: an unknown voxel that n views flown have reached without measuring it counts as seen (stereo
     leaves texture it cannot match unknown)."""
@@ -162,9 +168,9 @@ class LookaheadOptions:
         if self.frontier < 0 or self.patience < 0 or self.horizon < 1:
             raise ValueError(f"lookahead's frontier and patience are counts >= 0 (0: off) and its horizon "
                              f">= 1, got {self.frontier}, {self.patience}, {self.horizon}")
-        if not (0 <= self.allowance_m < float("inf") and 0 <= self.excess < float("inf")):
-            raise ValueError(f"lookahead's flight allowance and excess weight are finite and >= 0, got "
-                             f"{self.allowance_m}, {self.excess}")
+        if not all(0 <= x < float("inf") for x in (self.allowance_m, self.excess, self.battery_per_view_m)):
+            raise ValueError(f"lookahead's flight allowance, excess weight and battery a view are finite and "
+                             f">= 0, got {self.allowance_m}, {self.excess}, {self.battery_per_view_m}")
         if not 0 <= self.sides < float("inf"):
             raise ValueError(f"lookahead's weight of a side never measured is finite and >= 0, got "
                              f"{self.sides}")
@@ -175,6 +181,11 @@ class LookaheadOptions:
                 or not 0 <= self.agree <= len(self.partners):
             raise ValueError(f"lookahead-stereo's partners are sides from {PARTNER_SIDES} and agree 0 to "
                              f"their number, got {self.partners}, {self.agree}")
+
+    def battery(self, views: int) -> float:
+        """The metres flown before `excess` is charged on a flight of `views` views: `allowance_m`, or
+        `battery_per_view_m` a view where that is more."""
+        return max(self.allowance_m, self.battery_per_view_m * views)
 
     @property
     def masks(self) -> bool:
@@ -229,7 +240,8 @@ class LookaheadPlanner(Planner):
 
         view, chosen, edge, occupied = world.start, [world.start], None, None
         looked = np.zeros(voxels, np.uint16)  # views flown that reached each voxel, still unknown
-        for left in range((self.default_views if views is None else views) - 1, 0, -1):
+        count = self.default_views if views is None else views
+        for left in range(count - 1, 0, -1):
             self.measure(world, grid, view)
             seen.clear()
             edge = grid.frontier() if options.next_to_free else None
@@ -241,7 +253,7 @@ class LookaheadPlanner(Planner):
             known, weights = side_items(grid, occupied, known, options.sides)
             scores = expert_scores(view, known, sees, step, self.flight, left, options.horizon, DISCOUNT,
                                    flown_m=shell_path(chosen[0], chosen[1:]).total_m,
-                                   allowance_m=options.allowance_m, excess_weight=options.excess,
+                                   allowance_m=options.battery(count), excess_weight=options.excess,
                                    weights=weights, total=voxels)
             if options.masks:
                 ruled = np.array([ruled_out(step(action, view), chosen, options) for action in CANDIDATES])
@@ -342,13 +354,14 @@ def stereo_lookahead_planner(settings: PlanSettings, seed: int, argument: str | 
     """The registry's `lookahead-stereo`: the look-ahead on stereo depth from two frames a view, on forward
     steps, valuing sides never measured, under a battery's hinge: the validated setting, or
     `lookahead-stereo:W` another flight weight, `lookahead-stereo:W,M` (or `:,M`) a battery of M metres
-    before the hinge instead of `STEREO_HINGE`'s."""
+    before the hinge whatever the views, instead of `STEREO_HINGE`'s that grows past 13 views."""
     weight, comma, battery = (argument or "").partition(",")
     flight = flight_weight(weight) if weight else STEREO_FLIGHT
-    allowance = battery_metres(battery) if comma else STEREO_HINGE[0]
+    allowance, per_view = (battery_metres(battery), 0.0) if comma else (STEREO_HINGE[0], STEREO_PER_VIEW)
     return LookaheadPlanner(flight=flight, depth="stereo", blank_images=settings.blank_images,
                             options=LookaheadOptions(forward=STEREO_FORWARD, sides=STEREO_SIDES,
-                                                     allowance_m=allowance, excess=STEREO_HINGE[1]))
+                                                     allowance_m=allowance, excess=STEREO_HINGE[1],
+                                                     battery_per_view_m=per_view))
 
 
 def battery_metres(argument: str) -> float:

@@ -18,6 +18,7 @@ from nbv.planning.lookahead import (
     STEREO_BASELINE_M,
     STEREO_FLIGHT,
     STEREO_HINGE,
+    STEREO_PER_VIEW,
     STEREO_SIDES,
     LookaheadOptions,
     LookaheadPlanner,
@@ -79,8 +80,20 @@ def test_past_its_allowance_a_hinged_flight_takes_the_shortest_leg_and_free_befo
     views = tiny(0.0, allowance_m=0.0, excess=1e5).plan(world, 2)
     legs = [shell_path(world.start, [s]).total_m for s in steps_from(world.start, env)]
     assert shell_path(world.start, views[1:]).total_m == min(legs)
-    with pytest.raises(ValueError, match="allowance and excess weight are finite and >= 0, got 1.0, -2"):
+    with pytest.raises(ValueError, match="excess weight and battery a view are finite and >= 0, got 1.0, -2"):
         LookaheadOptions(allowance_m=1.0, excess=-2)
+
+
+def test_a_battery_that_follows_the_views_grows_past_the_allowance_and_frees_the_flight():
+    grows = LookaheadOptions(allowance_m=13.0, battery_per_view_m=1.0)
+    assert [grows.battery(v) for v in (5, 13, 20)] == [13.0, 13.0, 20.0]
+    assert LookaheadOptions(allowance_m=13.0).battery(20) == 13.0
+    world = PlanningWorld(config(), seed=3)
+    free = LookaheadPlanner(flight=0.0, grid=16, rays=8).plan(world, 3)
+    assert tiny(0.0, allowance_m=0.0, excess=1e5, battery_per_view_m=1e3).plan(world, 3) == free
+    assert tiny(0.0, allowance_m=0.0, excess=1e5).plan(world, 3) != free
+    with pytest.raises(ValueError, match="battery a view are finite and >= 0, got 0.0, 0.0, -1"):
+        LookaheadOptions(battery_per_view_m=-1)
 
 
 def test_with_patience_it_gives_up_on_what_it_looked_at_without_measuring():
@@ -199,9 +212,11 @@ def test_the_spec_sets_the_flight_weight_and_refuses_bad_ones():
         lookahead_planner(PlanSettings(), 0, "-1")
     battery = make_planner("lookahead-stereo:0.2,20", PlanSettings())
     assert (battery.flight, battery.options.allowance_m, battery.options.excess) == (0.2, 20, STEREO_HINGE[1])
+    assert battery.options.battery(30) == 20  # a pilot's battery stays whatever the views
     battery = make_planner("lookahead-stereo:,9.5", PlanSettings())
     assert (battery.flight, battery.options.allowance_m) == (STEREO_FLIGHT, 9.5)
-    assert make_planner("lookahead-stereo:0.2", PlanSettings()).options.allowance_m == STEREO_HINGE[0]
+    default = make_planner("lookahead-stereo:0.2", PlanSettings()).options
+    assert (default.allowance_m, default.battery(20)) == (STEREO_HINGE[0], max(13, 20 * STEREO_PER_VIEW))
     for bad in ("0.1,0", "0.1,-3", "0.1,far", "0.1,inf", "0.1,"):
         with pytest.raises(ValueError, match=f"battery of M > 0 metres before the hinge, got '{bad[4:]}'"):
             stereo_lookahead_planner(PlanSettings(), 0, bad)
@@ -282,8 +297,9 @@ def test_stereo_measures_the_building_and_blank_frames_measure_nothing():
     stereo = make_planner("lookahead-stereo", PlanSettings())
     assert (stereo.name, stereo.flight, stereo.depth) == ("lookahead-stereo", STEREO_FLIGHT, "stereo")
     assert stereo.options == LookaheadOptions(forward=True, sides=STEREO_SIDES, allowance_m=STEREO_HINGE[0],
-                                              excess=STEREO_HINGE[1])
+                                              excess=STEREO_HINGE[1], battery_per_view_m=STEREO_PER_VIEW)
     assert STEREO_HINGE == (13.0, 2.0) and STEREO_SIDES == 1.0  # round 31's setting
+    assert STEREO_PER_VIEW == 0.0  # until round 33 decides
     assert make_planner("lookahead-stereo:0.2", PlanSettings(blank_images=True)).blank_images
     with pytest.raises(ValueError, match="depth from"):
         LookaheadPlanner(depth="lidar")

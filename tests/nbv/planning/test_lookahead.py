@@ -216,7 +216,7 @@ def test_the_spec_sets_the_flight_weight_and_refuses_bad_ones():
     battery = make_planner("lookahead-stereo:,9.5", PlanSettings())
     assert (battery.flight, battery.options.allowance_m) == (STEREO_FLIGHT, 9.5)
     default = make_planner("lookahead-stereo:0.2", PlanSettings()).options
-    assert (default.allowance_m, default.battery(20)) == (STEREO_HINGE[0], max(13, 20 * STEREO_PER_VIEW))
+    assert (default.allowance_m, default.battery(20)) == (STEREO_HINGE[0], 20.0)
     for bad in ("0.1,0", "0.1,-3", "0.1,far", "0.1,inf", "0.1,"):
         with pytest.raises(ValueError, match=f"battery of M > 0 metres before the hinge, got '{bad[4:]}'"):
             stereo_lookahead_planner(PlanSettings(), 0, bad)
@@ -299,7 +299,7 @@ def test_stereo_measures_the_building_and_blank_frames_measure_nothing():
     assert stereo.options == LookaheadOptions(forward=True, sides=STEREO_SIDES, allowance_m=STEREO_HINGE[0],
                                               excess=STEREO_HINGE[1], battery_per_view_m=STEREO_PER_VIEW)
     assert STEREO_HINGE == (13.0, 2.0) and STEREO_SIDES == 1.0  # round 31's setting
-    assert STEREO_PER_VIEW == 0.0  # until round 33 decides
+    assert STEREO_PER_VIEW == 1.0  # round 33's: 13 m up to 13 views, one a view past them
     assert make_planner("lookahead-stereo:0.2", PlanSettings(blank_images=True)).blank_images
     with pytest.raises(ValueError, match="depth from"):
         LookaheadPlanner(depth="lidar")

@@ -285,7 +285,8 @@ INDEX = (
            "make tables"),
     Result("budget_lookahead/budget.md", "budget_lookahead/budget.json", "lookahead-stereo against view "
            "budget and metres flown beside the tuned rings and random views (the budget part's settings, no "
-           "oracle)", "nbv tables --part budget --planners random orbit orbit2 lookahead-stereo --out OUT "
+           "oracle; before round 33, the 13 m battery at every budget)",
+           "nbv tables --part budget --planners random orbit orbit2 lookahead-stereo --out OUT "
            "(OUT/budget/)"),
     Result("online/online.md", "online/online.json", "the shipped policy and the paper "
            "preset's against the baselines, 13 views, five held-out buildings, one pass",

@@ -380,6 +380,8 @@ INDEX = (
            "round: what a 20 m battery buys lookahead-stereo at 20 views (informational)", LOOKS_EVAL),
     Result("selection/round33/README.md", "selection/round33/batteryfollows/results.json", "its "
            "thirty-third round: a battery that follows the view budget, at 16 views (adopted)", LOOKS_EVAL),
+    Result("selection/round34/README.md", "selection/round34/sides3_hinge/results.json", "its "
+           "thirty-fourth round: the sides term at 3 under the battery's hinge (not adopted)", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

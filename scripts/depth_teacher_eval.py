@@ -20,6 +20,7 @@ never steps within M metres of a camera flown (_spM). Round 30: `--sight D`
 never steps to a view whose sight line lies within D degrees of one flown's (_siD). Round 31: `--sides W`
 values each occupied voxel met from a direction it was never measured from at W unknown voxels (_sdW).
 Round 33: `--per-view P` grows the battery to P metres a view where that passes --allowance (_pvP).
+Round 35: `--steep D` gives rays looking down more steeply than D degrees sight bins of their own (_stpD).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -88,12 +89,15 @@ def arguments() -> argparse.Namespace:
     parser.add_argument("--sides", type=float, default=0.0,
                         help="an occupied voxel met from a direction never measured is worth this many "
                              "unknown voxels (0: nothing)")
+    parser.add_argument("--steep", type=float, default=0.0,
+                        help="with --sides, rays looking down more steeply than this many degrees are a "
+                             "direction of their own (0: none)")
     looks_eval.study_arguments(parser)
     return parser.parse_args()
 
 
 def named(options: LookaheadOptions) -> str:
-    """A run's name ending for `options`' variants (rounds 27 to 33), empty for the teacher's own."""
+    """A run's name ending for `options`' variants (rounds 27 to 35), empty for the teacher's own."""
     o = options
     return (f"_f{o.frontier}" if o.frontier else "") \
         + (f"_h{o.allowance_m:g}x{o.excess:g}" if o.excess else "") \
@@ -101,7 +105,8 @@ def named(options: LookaheadOptions) -> str:
         + (f"_p{o.patience}" if o.patience else "") \
         + (f"_H{o.horizon}" if o.horizon != HORIZON else "") + ("_nf" if o.next_to_free else "") \
         + ("_fw" if o.forward else "") + (f"_sp{o.spacing_m:g}" if o.spacing_m else "") \
-        + (f"_si{o.sight_deg:g}" if o.sight_deg else "") + (f"_sd{o.sides:g}" if o.sides else "")
+        + (f"_si{o.sight_deg:g}" if o.sight_deg else "") + (f"_sd{o.sides:g}" if o.sides else "") \
+        + (f"_stp{o.steep_deg:g}" if o.steep_deg else "")
 
 
 def stereo_suffix(paired: LookaheadOptions) -> str:
@@ -121,7 +126,7 @@ def main() -> None:
     options = LookaheadOptions(frontier=args.frontier, allowance_m=args.allowance, excess=args.excess,
                                patience=args.patience, horizon=args.horizon, next_to_free=args.next_to_free,
                                forward=args.forward, spacing_m=args.spacing, sight_deg=args.sight,
-                               sides=args.sides, battery_per_view_m=args.per_view)
+                               sides=args.sides, battery_per_view_m=args.per_view, steep_deg=args.steep)
     paired = replace(options, partners=tuple(args.partners), agree=args.agree, votes=args.votes)
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"

@@ -47,7 +47,8 @@ def target_grid(scene: Scene, config: OccupancyConfig) -> OccupancyGrid:
                          "target's bounds, which it does not give")
     lower, upper = scene.bounds()
     margin = config.grid_margin_m
-    return OccupancyGrid(lower - [margin, margin, 0.0], upper + margin, config.grid_resolution, config.votes)
+    return OccupancyGrid(lower - [margin, margin, 0.0], upper + margin, config.grid_resolution, config.votes,
+                         config.steep_deg)
 
 
 class InfoGainPlanner(Planner):

@@ -63,7 +63,7 @@ from nbv.flight.path import azimuth_step, shell_path, shell_position
 from nbv.planning.base import Planner
 from nbv.planning.infogain import target_grid
 from nbv.recon.config import OccupancyConfig
-from nbv.recon.occupancy import OCCUPIED, SIGHT_BINS, UNKNOWN, OccupancyGrid
+from nbv.recon.occupancy import OCCUPIED, UNKNOWN, OccupancyGrid
 from nbv.recon.stereo import StereoConfig, agreed_depth, box_stereo_depth, grayscale
 from nbv.rl.env import action_to_viewpoint
 from nbv.rl.expert import CANDIDATES, best_action, expert_scores
@@ -167,6 +167,10 @@ class LookaheadOptions:
     meet from a direction it was never measured from (`OccupancyGrid.sighted`; round 31): an occupied voxel
     holds every face of the surface in it, so the unknown-voxel gain alone cannot see that an eave's
     underside or a parapet's inner face was never in view."""
+    steep_deg: float = 0.0
+    """> 0, with `sides`: rays looking down more steeply than this many degrees are a direction of their own
+    (`OccupancyGrid`'s `steep_deg`; round 35): a wall seen only from nearly overhead, at a grazing angle,
+    still gains a view that meets it from the side."""
 
     def __post_init__(self) -> None:
         if self.frontier < 0 or self.patience < 0 or self.horizon < 1:
@@ -175,9 +179,9 @@ class LookaheadOptions:
         if not all(0 <= x < float("inf") for x in (self.allowance_m, self.excess, self.battery_per_view_m)):
             raise ValueError(f"lookahead's flight allowance, excess weight and battery a view are finite and "
                              f">= 0, got {self.allowance_m}, {self.excess}, {self.battery_per_view_m}")
-        if not 0 <= self.sides < float("inf"):
-            raise ValueError(f"lookahead's weight of a side never measured is finite and >= 0, got "
-                             f"{self.sides}")
+        if not 0 <= self.sides < float("inf") or not 0 <= self.steep_deg < 90:
+            raise ValueError(f"lookahead's weight of a side never measured is finite and >= 0 and its steep "
+                             f"band under 90 degrees (0: none), got {self.sides}, {self.steep_deg}")
         if not 0 <= self.spacing_m < float("inf") or not 0 <= self.sight_deg < 180:
             raise ValueError(f"lookahead's spacing is a finite distance >= 0 and its sight rule 0 to 180 "
                              f"degrees (0: none), got {self.spacing_m}, {self.sight_deg}")
@@ -221,7 +225,7 @@ class LookaheadPlanner(Planner):
         camera, center, options = world.camera, world.target.center(), self.options
         stride = max(1, round(camera.width / self.rays))
         grid = target_grid(world.target, OccupancyConfig(grid_resolution=self.grid, gain_ray_stride=stride,
-                                                         votes=options.votes))
+                                                         votes=options.votes, steep_deg=options.steep_deg))
         steps = replace(world.env, action_mode="forward", relative_step=FORWARD_STEP) if options.forward \
             else replace(world.env, action_mode="orbit", relative_step=ORBIT_STEP)
 
@@ -297,11 +301,11 @@ class LookaheadPlanner(Planner):
 def side_items(grid: OccupancyGrid, occupied: np.ndarray, known: np.ndarray,
                sides: float) -> tuple[np.ndarray, np.ndarray | None]:
     """The look-ahead's samples with `sides` > 0: the grid's voxels (`known`), then each `occupied` voxel's
-    `SIGHT_BINS` directions, known where it has been measured from that direction (`OccupancyGrid.sides`);
+    `sight_bins` directions, known where it has been measured from that direction (`OccupancyGrid.sides`);
     and their worth (1 a voxel, `sides` a direction). Without, `known` and None."""
     if not sides:
         return known, None
-    measured = (grid.sides[occupied, None] >> np.arange(SIGHT_BINS, dtype=np.uint16)) & 1
+    measured = (grid.sides[occupied, None] >> np.arange(grid.sight_bins, dtype=np.uint16)) & 1
     weights = np.concatenate([np.ones(len(known)), np.full(measured.size, sides)])
     return np.concatenate([known, measured.astype(bool).reshape(-1)]), weights
 

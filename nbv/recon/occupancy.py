@@ -36,6 +36,10 @@ probabilistic:
   direction can (the viewing directions per voxel of surface-coverage planners,
   e.g. Vasquez-Gomez et al., "Volumetric next-best-view planning for 3D object
   reconstruction with positioning error", IJARS 2014, kept here as 12 bins).
+  With `steep_deg`, rays looking down more steeply than that take bins of their
+  own (16 in all): a wall seen only from nearly overhead is seen at a grazing
+  angle, where a photograph resolves little of it, and still counts as unmeasured
+  from the side (round 35).
 
 Depth is z-depth (docs/conventions.md, `render.renderer`): a pixel's ray has
 direction (x, y, 1) in the camera frame (`render.camera.pixel_rays`), so its hit
@@ -66,21 +70,28 @@ UNKNOWN, FREE, OCCUPIED = 0, 1, 2
 """Voxel states."""
 SIGHT_BINS, LEVEL_SIN = 12, np.sin(np.radians(10.0))
 """Directions a voxel is measured from: 4 horizontal quadrants, each looking up, level or down (a ray's
-vertical part beyond `LEVEL_SIN` of its length, 10 degrees)."""
+vertical part beyond `LEVEL_SIN` of its length, 10 degrees); with a steep band (`sight_bin`), 16."""
 CHUNK_SAMPLES = 1 << 21
 """Ray samples held at once (a few arrays of 2M numbers)."""
 
 
-def sight_bin(directions: np.ndarray) -> np.ndarray:
+def sight_bin(directions: np.ndarray, steep_deg: float = 0.0) -> np.ndarray:
     """The bin (0 to `SIGHT_BINS` - 1) of each unit ray direction (..., 3): its horizontal quadrant (by the
-    larger of |x| and |y| and its sign) times 3, plus 0 looking down, 1 level, 2 looking up.
+    larger of |x| and |y| and its sign) times 3, plus 0 looking down, 1 level, 2 looking up. With
+    `steep_deg` > 0, the quadrant times 4, plus 0 looking down more steeply than that, then 1, 2, 3 as above
+    (16 bins).
 
     >>> sight_bin(np.array([[1.0, 0, 0], [0, -0.9, 0.44], [-0.6, 0.5, -0.62]])).tolist()
     [4, 2, 6]
+    >>> sight_bin(np.array([[1.0, 0, 0], [0.5, 0, -0.87], [0.87, 0, -0.5]]), steep_deg=45).tolist()
+    [6, 4, 5]
     """
     x, y, z = directions[..., 0], directions[..., 1], directions[..., 2]
     quadrant = np.where(np.abs(x) >= np.abs(y), np.where(x >= 0, 1, 2), np.where(y >= 0, 3, 0))
-    return (3 * quadrant + (z > -LEVEL_SIN) + (z > LEVEL_SIN)).astype(np.int64)
+    band = (z > -LEVEL_SIN).astype(np.int64) + (z > LEVEL_SIN)
+    if not steep_deg:
+        return 3 * quadrant + band
+    return 4 * quadrant + band + (z >= -np.sin(np.radians(steep_deg)))
 
 
 class OccupancyGrid:
@@ -91,9 +102,12 @@ class OccupancyGrid:
         upper: (3,) its upper corner; the grid reaches at least this far (whole voxels).
         resolution: voxels along the box's longest side.
         votes: weigh hits and passes, one vote an image (module docstring), instead of occupied winning.
+        steep_deg: > 0, rays looking down more steeply than this many degrees are a direction of their own
+            (`sight_bin`, `sight_bins` 16).
     """
 
-    def __init__(self, lower: np.ndarray, upper: np.ndarray, resolution: int, votes: bool = False) -> None:
+    def __init__(self, lower: np.ndarray, upper: np.ndarray, resolution: int, votes: bool = False,
+                 steep_deg: float = 0.0) -> None:
         self.lower = np.asarray(lower, dtype=np.float64)
         extent = np.asarray(upper, dtype=np.float64) - self.lower
         if extent.shape != (3,) or not np.all(np.isfinite(extent)) or np.any(extent <= 0):
@@ -104,7 +118,11 @@ class OccupancyGrid:
         shape = np.maximum(np.ceil(extent / self.voxel_size - 1e-9), 1).astype(np.int64)
         self.state = np.zeros(tuple(int(n) for n in shape), dtype=np.uint8)
         self.upper = self.lower + shape * self.voxel_size
-        self.votes = votes
+        if not 0 <= steep_deg < 90 or 0 < steep_deg <= np.degrees(np.arcsin(LEVEL_SIN)):
+            raise ValueError(f"occupancy grid's steep band starts past the level band's 10 degrees and under "
+                             f"90 (0: none), got {steep_deg}")
+        self.votes, self.steep_deg = votes, steep_deg
+        self.sight_bins = SIGHT_BINS + 4 if steep_deg else SIGHT_BINS
         self.sides = np.zeros(self.state.size, np.uint16)  # bit b: measured from `sight_bin` b
         self.hits, self.passes = (np.zeros(self.state.size if votes else 0, np.uint32) for _ in range(2))
 
@@ -135,7 +153,7 @@ class OccupancyGrid:
         voxels, toward = self.voxel_index(hits[inside]), rays[depth > 0][inside]
         hit = np.zeros(flat.size, dtype=bool)
         hit[voxels] = True
-        bins = sight_bin(toward / np.linalg.norm(toward, axis=-1, keepdims=True))
+        bins = sight_bin(toward / np.linalg.norm(toward, axis=-1, keepdims=True), self.steep_deg)
         np.bitwise_or.at(self.sides, voxels, (1 << bins).astype(np.uint16))
         if not self.votes:
             flat[crossed & (flat != OCCUPIED)] = FREE
@@ -161,7 +179,7 @@ class OccupancyGrid:
 
     def sighted(self, K: np.ndarray, c2w: np.ndarray, width: int, height: int,  # noqa: N803
                 stride: int = 1) -> np.ndarray:
-        """(voxels, `SIGHT_BINS`) bool: the occupied voxel every `stride`-th pixel's ray meets first (past
+        """(voxels, `sight_bins`) bool: the occupied voxel every `stride`-th pixel's ray meets first (past
         free and unknown voxels), in the bin of the ray's direction (`sight_bin`)."""
         return self.look(K, c2w, width, height, stride, sides=True)[1]
 
@@ -175,8 +193,8 @@ class OccupancyGrid:
         rays = rays / np.linalg.norm(rays, axis=-1, keepdims=True)
         flat = self.state.reshape(-1)
         reached = np.zeros(flat.size, dtype=bool)
-        sighted = np.zeros((flat.size, SIGHT_BINS), dtype=bool) if sides else None
-        bins, done = sight_bin(rays) if sides else None, 0
+        sighted = np.zeros((flat.size, self.sight_bins), dtype=bool) if sides else None
+        bins, done = sight_bin(rays, self.steep_deg) if sides else None, 0
         for index, valid in self._walk(origin, rays, np.full(len(rays), np.inf)):
             state = flat[index]
             occupied = valid & (state == OCCUPIED)

@@ -145,8 +145,18 @@ def test_valuing_unmeasured_sides_changes_a_looking_flight_but_not_a_blind_one()
     assert tiny(0.0, forward=True, sides=50.0).plan(world, 4) != plain  # occupied voxels seen from new sides
     blind = tiny(0.0, "stereo", True, forward=True).plan(world, 3)
     assert tiny(0.0, "stereo", True, forward=True, sides=50.0).plan(world, 3) == blind  # nothing measured
-    with pytest.raises(ValueError, match="weight of a side never measured is finite and >= 0, got -1"):
+    with pytest.raises(ValueError, match="weight of a side never measured is finite and >= 0 and its steep "
+                                         "band under 90 degrees .0: none., got -1"):
         LookaheadOptions(sides=-1)
+
+
+def test_a_steep_band_changes_a_flight_that_values_sides_and_only_that():
+    world = PlanningWorld(config(), seed=3)
+    plain, sides = tiny(0.0, forward=True).plan(world, 4), tiny(0.0, forward=True, sides=50.0).plan(world, 4)
+    assert tiny(0.0, forward=True, steep_deg=60.0).plan(world, 4) == plain  # no sides valued: no change
+    assert tiny(0.0, forward=True, sides=50.0, steep_deg=60.0).plan(world, 4) != sides
+    with pytest.raises(ValueError, match="steep band under 90 degrees .0: none., got 0.0, 90"):
+        LookaheadOptions(steep_deg=90)
 
 
 def test_crowds_measures_the_straight_line_between_cameras():

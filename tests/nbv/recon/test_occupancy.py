@@ -102,6 +102,29 @@ def test_sight_bins_split_quadrants_and_looking_up_level_or_down_at_10_degrees()
     assert SIGHT_BINS == 12
 
 
+def test_a_steep_band_gives_rays_looking_down_past_it_bins_of_their_own():
+    def looking_down(degrees: float) -> np.ndarray:
+        return np.array([np.cos(np.radians(degrees)), 0, -np.sin(np.radians(degrees))])
+
+    rays = np.array([looking_down(d) for d in (61, 59, 11, 0, -11)])  # the +x quadrant
+    assert sight_bin(rays).tolist() == [3, 3, 3, 4, 5]  # down, down, down, level, up
+    assert sight_bin(rays, steep_deg=60).tolist() == [4, 5, 5, 6, 7]  # steep, down, down, level, up
+    facing_minus_y = -rays[:, [1, 0, 2]] * [1, 1, -1]  # the same tilts in the -y quadrant (0)
+    assert sight_bin(facing_minus_y, steep_deg=60).tolist() == [0, 1, 1, 2, 3]
+    with pytest.raises(ValueError, match="steep band starts past the level band's 10 degrees and under 90"):
+        OccupancyGrid(np.zeros(3), np.ones(3), resolution=2, steep_deg=10)
+
+
+def test_a_grid_with_a_steep_band_records_a_hit_from_overhead_in_it():
+    down = np.array([[1, 0, 0, 0.5], [0, -1, 0, 0.5], [0, 0, -1, 5.0], [0, 0, 0, 1]])  # at z = 5, looks -z
+    column = [OccupancyGrid(np.zeros(3), np.array([1.0, 1.0, 4.0]), resolution=4, steep_deg=steep)
+              for steep in (0.0, 60.0)]
+    for grid in column:
+        grid.integrate(np.array([[3.5]], np.float32), ONE_PIXEL, down)  # voxel 1 (z 1 to 2) hit from above
+    assert [grid.sides[:4].tolist() for grid in column] == [[0, 1 << 3, 0, 0], [0, 1 << 4, 0, 0]]
+    assert [grid.sighted(ONE_PIXEL, down, 1, 1).shape for grid in column] == [(4, 12), (4, 16)]
+
+
 def test_sides_record_the_direction_a_hit_was_measured_from_and_sighted_names_new_ones():
     grid = row_of_four()
     assert not grid.sighted(ONE_PIXEL, ALONG_X, 1, 1).any()  # nothing occupied: nothing met

@@ -19,6 +19,8 @@ class Planner(ABC):
 
     name: str = ""
     """Short name used on the command line and in tables."""
+    default_views: int
+    """How many viewpoints it plans when `plan` is given None (set by the planners that count their own)."""
 
     @abstractmethod
     def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
@@ -28,6 +30,10 @@ class Planner(ABC):
             world: the target, the allowed ranges, the camera, the view source and the start view.
             views: how many viewpoints; None for the planner's own count.
         """
+
+    def view_count(self, views: int | None) -> int:
+        """`views`, or the planner's own count (`default_views`) where it is None."""
+        return self.default_views if views is None else views
 
     def planning_env(self, own: EnvConfig) -> EnvConfig:
         """The env settings it plans in, given the plan's own (`nbv.planning.plan.scan_env_config`): those

@@ -80,7 +80,7 @@ class InfoGainPlanner(Planner):
         flown = FlownLinks(self.links, camera.K) if self.links.on else None
         if flown is not None:
             flown.add(view, world.source.features_at(view))
-        for _ in range((self.default_views if views is None else views) - 1):
+        for _ in range(self.view_count(views) - 1):
             grid.integrate(world.source.render_depth(view), camera.K, viewpoint_to_c2w(view, center),
                            self.grid.integrate_ray_stride)
             candidates = sample_viewpoints(world.low, world.high, self.candidates, rng)

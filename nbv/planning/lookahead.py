@@ -248,7 +248,7 @@ class LookaheadPlanner(Planner):
 
         view, chosen, edge, occupied = world.start, [world.start], None, None
         looked = np.zeros(voxels, np.uint16)  # views flown that reached each voxel, still unknown
-        count = self.default_views if views is None else views
+        count = self.view_count(views)
         for left in range(count - 1, 0, -1):
             self.measure(world, grid, view)
             seen.clear()

@@ -106,7 +106,7 @@ class CoverageOraclePlanner(Planner):
 
     def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """`views` viewpoints: the best, on the reported coverage, of its own set and the baselines'."""
-        count = self.default_views if views is None else views
+        count = self.view_count(views)
         if (world.env.camera, world.env.render) != (self.settings.camera, self.settings.render):
             raise ValueError("oracle: the world's camera or render settings differ from the plan's, so its "
                              "scores would not be the report's; plan in the plan's own env "

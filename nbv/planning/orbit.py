@@ -112,7 +112,7 @@ class OrbitPlanner(Planner):
         for ring in self.rings:
             check_ring(ring, radius, elevation, f"{self.name} planner")
         chosen = []
-        counts = split_views(self.default_views if views is None else views, len(self.rings))
+        counts = split_views(self.view_count(views), len(self.rings))
         for k, (ring, count) in enumerate(zip(self.rings, counts)):
             offset = k / len(self.rings)  # ring k starts k/len(rings) of its step on: the rings interleave
             chosen += [Viewpoint(ring.radius, world.start.azimuth + TWO_PI * (j + offset) / count,

@@ -67,7 +67,7 @@ class RandomPlanner(Planner):
 
     def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """`views` (default 13, the paper's Fig. 1 count) random viewpoints."""
-        count = self.default_views if views is None else views
+        count = self.view_count(views)
         rng = np.random.default_rng(self.seed)
         if not self.links.on:
             return sample_viewpoints(world.low, world.high, count, rng)
@@ -95,7 +95,7 @@ class CirclePlanner(Planner):
 
     def plan(self, world: PlanningWorld, views: int | None) -> list[Viewpoint]:
         """`views` (default 13) viewpoints on one ring."""
-        count = self.default_views if views is None else views
+        count = self.view_count(views)
         mid = (world.low + world.high) / 2.0
         return [Viewpoint(float(mid[0]), TWO_PI * k / count, float(mid[2])) for k in range(count)]
 
@@ -136,7 +136,7 @@ class GreedyBoVPlanner(Planner):
         chosen = [start]
         if flown is not None:
             flown.add(start, features)
-        for _ in range((self.default_views if views is None else views) - 1):
+        for _ in range(self.view_count(views) - 1):
             candidates = sample_viewpoints(world.low, world.high, self.candidates, rng)
             looked = [look(source, view, flown) for view in candidates]
             rewards = [bov.reward(d, view.azimuth, view.elevation, commit=False)

@@ -20,7 +20,9 @@ never steps within M metres of a camera flown (_spM). Round 30: `--sight D`
 never steps to a view whose sight line lies within D degrees of one flown's (_siD). Round 31: `--sides W`
 values each occupied voxel met from a direction it was never measured from at W unknown voxels (_sdW).
 Round 33: `--per-view P` grows the battery to P metres a view where that passes --allowance (_pvP).
-Round 35: `--steep D` gives rays looking down more steeply than D degrees sight bins of their own (_stpD).
+Round 35: `--steep D` gives rays looking down more steeply than D degrees sight bins of their own (_stpD);
+round 36: `--steep-blind` makes that band measure no side instead (_stpDb); `--ceiling C` holds every step at
+or under C degrees of elevation (_ceC).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -92,12 +94,16 @@ def arguments() -> argparse.Namespace:
     parser.add_argument("--steep", type=float, default=0.0,
                         help="with --sides, rays looking down more steeply than this many degrees are a "
                              "direction of their own (0: none)")
+    parser.add_argument("--steep-blind", action="store_true",
+                        help="with --steep, the steep band measures no side (neither marks nor gains one)")
+    parser.add_argument("--ceiling", type=float, default=0.0,
+                        help="every step's elevation at most this many degrees (0: the action space's own)")
     looks_eval.study_arguments(parser)
     return parser.parse_args()
 
 
 def named(options: LookaheadOptions) -> str:
-    """A run's name ending for `options`' variants (rounds 27 to 35), empty for the teacher's own."""
+    """A run's name ending for `options`' variants (rounds 27 to 36), empty for the teacher's own."""
     o = options
     return (f"_f{o.frontier}" if o.frontier else "") \
         + (f"_h{o.allowance_m:g}x{o.excess:g}" if o.excess else "") \
@@ -106,7 +112,8 @@ def named(options: LookaheadOptions) -> str:
         + (f"_H{o.horizon}" if o.horizon != HORIZON else "") + ("_nf" if o.next_to_free else "") \
         + ("_fw" if o.forward else "") + (f"_sp{o.spacing_m:g}" if o.spacing_m else "") \
         + (f"_si{o.sight_deg:g}" if o.sight_deg else "") + (f"_sd{o.sides:g}" if o.sides else "") \
-        + (f"_stp{o.steep_deg:g}" if o.steep_deg else "")
+        + (f"_stp{o.steep_deg:g}" + "b" * (not o.steep_measures) if o.steep_deg else "") \
+        + (f"_ce{o.ceiling_deg:g}" if o.ceiling_deg else "")
 
 
 def stereo_suffix(paired: LookaheadOptions) -> str:
@@ -126,7 +133,8 @@ def main() -> None:
     options = LookaheadOptions(frontier=args.frontier, allowance_m=args.allowance, excess=args.excess,
                                patience=args.patience, horizon=args.horizon, next_to_free=args.next_to_free,
                                forward=args.forward, spacing_m=args.spacing, sight_deg=args.sight,
-                               sides=args.sides, battery_per_view_m=args.per_view, steep_deg=args.steep)
+                               sides=args.sides, battery_per_view_m=args.per_view, steep_deg=args.steep,
+                               steep_measures=not args.steep_blind, ceiling_deg=args.ceiling)
     paired = replace(options, partners=tuple(args.partners), agree=args.agree, votes=args.votes)
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"

@@ -171,6 +171,13 @@ class LookaheadOptions:
     """> 0, with `sides`: rays looking down more steeply than this many degrees are a direction of their own
     (`OccupancyGrid`'s `steep_deg`; round 35): a wall seen only from nearly overhead, at a grazing angle,
     still gains a view that meets it from the side."""
+    steep_measures: bool = True
+    """With `steep_deg`, whether the steep band is a direction like the others (round 35) or measures no
+    side (round 36): a steep ray then neither marks the side it meets as measured nor gains a view anything
+    for it (`side_columns`)."""
+    ceiling_deg: float = 0.0
+    """> 0: every step's elevation is held to at most this many degrees, in the look-ahead as in the flight
+    (round 36): a view from nearly overhead sees walls at a grazing angle."""
 
     def __post_init__(self) -> None:
         if self.frontier < 0 or self.patience < 0 or self.horizon < 1:
@@ -179,9 +186,11 @@ class LookaheadOptions:
         if not all(0 <= x < float("inf") for x in (self.allowance_m, self.excess, self.battery_per_view_m)):
             raise ValueError(f"lookahead's flight allowance, excess weight and battery a view are finite and "
                              f">= 0, got {self.allowance_m}, {self.excess}, {self.battery_per_view_m}")
-        if not 0 <= self.sides < float("inf") or not 0 <= self.steep_deg < 90:
-            raise ValueError(f"lookahead's weight of a side never measured is finite and >= 0 and its steep "
-                             f"band under 90 degrees (0: none), got {self.sides}, {self.steep_deg}")
+        if not 0 <= self.sides < float("inf") or not 0 <= self.steep_deg < 90 \
+                or not 0 <= self.ceiling_deg <= 90:
+            raise ValueError(f"lookahead's weight of a side never measured is finite and >= 0, its steep "
+                             f"band under 90 degrees and its ceiling at most 90 (0: none), got {self.sides}, "
+                             f"{self.steep_deg}, {self.ceiling_deg}")
         if not 0 <= self.spacing_m < float("inf") or not 0 <= self.sight_deg < 180:
             raise ValueError(f"lookahead's spacing is a finite distance >= 0 and its sight rule 0 to 180 "
                              f"degrees (0: none), got {self.spacing_m}, {self.sight_deg}")
@@ -240,13 +249,16 @@ class LookaheadPlanner(Planner):
                 if options.next_to_free:
                     seen[key] &= edge
                 if options.sides:  # then (occupied voxel, direction) items: `side_items`
-                    seen[key] = np.concatenate([seen[key], sighted[occupied].reshape(-1)])
+                    seen[key] = np.concatenate([seen[key], sighted[occupied][:, columns].reshape(-1)])
             return seen[key]
 
         def step(action: np.ndarray, view: Viewpoint) -> Viewpoint:
-            return action_to_viewpoint(action, view, steps)
+            reached = action_to_viewpoint(action, view, steps)
+            return replace(reached, elevation=min(reached.elevation, ceiling)) if options.ceiling_deg \
+                else reached
 
         view, chosen, edge, occupied = world.start, [world.start], None, None
+        columns, ceiling = side_columns(grid, options), np.radians(options.ceiling_deg)
         looked = np.zeros(voxels, np.uint16)  # views flown that reached each voxel, still unknown
         count = self.view_count(views)
         for left in range(count - 1, 0, -1):
@@ -258,7 +270,7 @@ class LookaheadPlanner(Planner):
             if options.patience:
                 looked += sees(view)[:voxels]
                 known |= looked >= options.patience
-            known, weights = side_items(grid, occupied, known, options.sides)
+            known, weights = side_items(grid, occupied, known, options.sides, columns)
             scores = expert_scores(view, known, sees, step, self.flight, left, options.horizon, DISCOUNT,
                                    flown_m=shell_path(chosen[0], chosen[1:]).total_m,
                                    allowance_m=options.battery(count), excess_weight=options.excess,
@@ -298,16 +310,23 @@ class LookaheadPlanner(Planner):
             grid.integrate(depth, camera.K, at, stride)
 
 
-def side_items(grid: OccupancyGrid, occupied: np.ndarray, known: np.ndarray,
-               sides: float) -> tuple[np.ndarray, np.ndarray | None]:
+def side_items(grid: OccupancyGrid, occupied: np.ndarray, known: np.ndarray, sides: float,
+               columns: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
     """The look-ahead's samples with `sides` > 0: the grid's voxels (`known`), then each `occupied` voxel's
-    `sight_bins` directions, known where it has been measured from that direction (`OccupancyGrid.sides`);
-    and their worth (1 a voxel, `sides` a direction). Without, `known` and None."""
+    directions `columns` (`side_columns`), known where it has been measured from that direction
+    (`OccupancyGrid.sides`); and their worth (1 a voxel, `sides` a direction). Without, `known` and None."""
     if not sides:
         return known, None
-    measured = (grid.sides[occupied, None] >> np.arange(grid.sight_bins, dtype=np.uint16)) & 1
+    measured = ((grid.sides[occupied, None] >> np.arange(grid.sight_bins, dtype=np.uint16)) & 1)[:, columns]
     weights = np.concatenate([np.ones(len(known)), np.full(measured.size, sides)])
     return np.concatenate([known, measured.astype(bool).reshape(-1)]), weights
+
+
+def side_columns(grid: OccupancyGrid, options: LookaheadOptions) -> np.ndarray:
+    """The grid's sight bins that count as sides: all, or without `steep_measures` all but the steep band's
+    (`nbv.recon.occupancy.sight_bin`: the first of each quadrant's four)."""
+    every = np.arange(grid.sight_bins)
+    return every if not grid.steep_deg or options.steep_measures else every[every % 4 != 0]
 
 
 def stereo_partner(view: Viewpoint, baseline: float = STEREO_BASELINE_M, side: str = "back") -> Viewpoint:

@@ -26,13 +26,14 @@ from nbv.planning.lookahead import (
     lookahead_planner,
     revisits,
     shares_sight,
+    side_columns,
     stereo_lookahead_planner,
     stereo_partner,
 )
 from nbv.planning.registry import make_planner
 from nbv.planning.world import PlanningWorld
 from nbv.recon.config import OccupancyConfig
-from nbv.recon.occupancy import UNKNOWN
+from nbv.recon.occupancy import UNKNOWN, OccupancyGrid
 from nbv.rl.env import action_to_viewpoint
 from nbv.rl.expert import CANDIDATES
 from nbv.rl.presets import ORBIT_STEP
@@ -145,8 +146,8 @@ def test_valuing_unmeasured_sides_changes_a_looking_flight_but_not_a_blind_one()
     assert tiny(0.0, forward=True, sides=50.0).plan(world, 4) != plain  # occupied voxels seen from new sides
     blind = tiny(0.0, "stereo", True, forward=True).plan(world, 3)
     assert tiny(0.0, "stereo", True, forward=True, sides=50.0).plan(world, 3) == blind  # nothing measured
-    with pytest.raises(ValueError, match="weight of a side never measured is finite and >= 0 and its steep "
-                                         "band under 90 degrees .0: none., got -1"):
+    with pytest.raises(ValueError, match="weight of a side never measured is finite and >= 0, its steep band "
+                                         "under 90 degrees and its ceiling at most 90 .0: none., got -1"):
         LookaheadOptions(sides=-1)
 
 
@@ -155,8 +156,21 @@ def test_a_steep_band_changes_a_flight_that_values_sides_and_only_that():
     plain, sides = tiny(0.0, forward=True).plan(world, 4), tiny(0.0, forward=True, sides=50.0).plan(world, 4)
     assert tiny(0.0, forward=True, steep_deg=60.0).plan(world, 4) == plain  # no sides valued: no change
     assert tiny(0.0, forward=True, sides=50.0, steep_deg=60.0).plan(world, 4) != sides
-    with pytest.raises(ValueError, match="steep band under 90 degrees .0: none., got 0.0, 90"):
+    with pytest.raises(ValueError, match="steep band under 90 degrees and its ceiling at most 90 .0: none., "
+                                         "got 0.0, 90"):
         LookaheadOptions(steep_deg=90)
+
+
+def test_a_steep_band_that_measures_no_side_drops_its_bins_and_flies_otherwise():
+    grid = OccupancyGrid(np.zeros(3), np.ones(3), resolution=2, steep_deg=60)
+    assert side_columns(grid, LookaheadOptions()).tolist() == list(range(16))
+    assert side_columns(grid, LookaheadOptions(steep_measures=False)).tolist() == \
+        [1, 2, 3, 5, 6, 7, 9, 10, 11, 13, 14, 15]  # each quadrant's down, level and up
+    plain = OccupancyGrid(np.zeros(3), np.ones(3), resolution=2)
+    assert side_columns(plain, LookaheadOptions(steep_measures=False)).tolist() == list(range(12))
+    world = PlanningWorld(config(), seed=3)
+    steep = tiny(0.0, forward=True, sides=50.0, steep_deg=60.0).plan(world, 4)
+    assert tiny(0.0, forward=True, sides=50.0, steep_deg=60.0, steep_measures=False).plan(world, 4) != steep
 
 
 def test_crowds_measures_the_straight_line_between_cameras():
@@ -313,3 +327,13 @@ def test_stereo_measures_the_building_and_blank_frames_measure_nothing():
     assert make_planner("lookahead-stereo:0.2", PlanSettings(blank_images=True)).blank_images
     with pytest.raises(ValueError, match="depth from"):
         LookaheadPlanner(depth="lidar")
+
+
+def test_a_ceiling_holds_every_step_at_or_under_it_and_changes_a_climbing_flight():
+    world = PlanningWorld(config(), seed=3)
+    free = tiny(0.0, forward=True, sides=50.0).plan(world, 6)
+    assert max(v.elevation for v in free[1:]) > np.radians(30)  # the free flight climbs past it
+    held = tiny(0.0, forward=True, sides=50.0, ceiling_deg=30.0).plan(world, 6)
+    assert held != free and max(v.elevation for v in held[1:]) <= np.radians(30) + 1e-12
+    with pytest.raises(ValueError, match="ceiling at most 90 .0: none., got 0.0, 0.0, 91"):
+        LookaheadOptions(ceiling_deg=91)

@@ -113,8 +113,9 @@ PLANNERS: tuple[PlannerEntry, ...] = (
                  "pilot's orbit: each step 27.7 to 55.4 degrees forward round the target, its radius and "
                  "elevation the look-ahead's choice; the grid fused from plane-sweep stereo depth of each "
                  "view and a second frame 0.25 m back along its orbit (reads images and poses, as the "
-                 "policies do), less 0.1 a metre and 2 a metre more past a battery of 13 m, one more a view "
-                 "past 13 views (lookahead-stereo:W another weight, lookahead-stereo:W,M or :,M a fixed "
+                 "policies do), valuing the sides of surface it has not yet measured (rays over 60 degrees "
+                 "down measure none), less 0.1 a metre and 2 a metre more past a battery of 13 m, one more a "
+                 "view past 13 views (lookahead-stereo:W another weight, lookahead-stereo:W,M or :,M a fixed "
                  "battery of M metres)",
                  "nbv.planning.lookahead:stereo_lookahead_planner", settings=("blank_images",),
                  argument="W,M", prefixes=False, image_option=True),

@@ -129,6 +129,12 @@ INDEX = (
     Result("selection/round35/README.md", "selection/round35/steep60/results.json", "its "
            "thirty-fifth round: a steep band of sight directions, both validation courtyards (not adopted)",
            LOOKS_EVAL),
+    Result("selection/round36/README.md", "selection/round36/steep60_blind/results.json", "its "
+           "thirty-sixth round: a steep band that measures no side, and a 45-degree ceiling (not adopted by "
+           "its rule)", LOOKS_EVAL),
+    Result("selection/round37/README.md", "selection/round37/steep60_blind/results.json", "its "
+           "thirty-seventh round: round 36's blind steep band from start views never flown (adopted)",
+           LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

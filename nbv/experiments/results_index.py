@@ -29,7 +29,7 @@ INDEX = (
            "make tables"),
     Result("budget_lookahead/budget.md", "budget_lookahead/budget.json", "lookahead-stereo against view "
            "budget and metres flown beside the tuned rings and random views (the budget part's settings, no "
-           "oracle; before round 33, the 13 m battery at every budget)",
+           "oracle; round 37's setting, newer than budget/)",
            "nbv tables --part budget --planners random orbit orbit2 lookahead-stereo --out OUT "
            "(OUT/budget/)"),
     Result("online/online.md", "online/online.json", "the shipped policy and the paper "

@@ -336,9 +336,8 @@ def side_items(grid: OccupancyGrid, occupied: np.ndarray, known: np.ndarray, sid
 
 def side_columns(grid: OccupancyGrid, options: LookaheadOptions) -> np.ndarray:
     """The grid's sight bins that count as sides: all, or without `steep_measures` all but the steep band's
-    (`nbv.recon.occupancy.sight_bin`: the first of each quadrant's four)."""
-    every = np.arange(grid.sight_bins)
-    return every if not grid.steep_deg or options.steep_measures else every[every % 4 != 0]
+    (`OccupancyGrid.side_bins`)."""
+    return np.arange(grid.sight_bins) if options.steep_measures else grid.side_bins()
 
 
 def stereo_partner(view: Viewpoint, baseline: float = STEREO_BASELINE_M, side: str = "back") -> Viewpoint:

@@ -122,9 +122,18 @@ class OccupancyGrid:
             raise ValueError(f"occupancy grid's steep band starts past the level band's 10 degrees and under "
                              f"90 (0: none), got {steep_deg}")
         self.votes, self.steep_deg = votes, steep_deg
-        self.sight_bins = SIGHT_BINS + 4 if steep_deg else SIGHT_BINS
         self.sides = np.zeros(self.state.size, np.uint16)  # bit b: measured from `sight_bin` b
         self.hits, self.passes = (np.zeros(self.state.size if votes else 0, np.uint32) for _ in range(2))
+
+    @property
+    def sight_bins(self) -> int:
+        """How many directions `sight_bin` tells apart here: 12, or 16 with a steep band."""
+        return SIGHT_BINS + 4 if self.steep_deg else SIGHT_BINS
+
+    def side_bins(self) -> np.ndarray:
+        """The sight bins but the steep band's (each quadrant's first of four, `sight_bin`); all, without."""
+        every = np.arange(self.sight_bins)
+        return every[every % 4 != 0] if self.steep_deg else every
 
     def integrate(self, depth: np.ndarray, K: np.ndarray, c2w: np.ndarray,  # noqa: N803
                   stride: int = 1) -> None:

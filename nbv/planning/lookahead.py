@@ -181,8 +181,8 @@ class LookaheadOptions:
     underside or a parapet's inner face was never in view."""
     steep_deg: float = 0.0
     """> 0, with `sides`: rays looking down more steeply than this many degrees are a direction of their own
-    (`OccupancyGrid`'s `steep_deg`; round 35): a wall seen only from nearly overhead, at a grazing angle,
-    still gains a view that meets it from the side."""
+    (`OccupancyGrid`'s `steep_deg`, set here alone: only the sides use it; round 35): a wall seen only from
+    nearly overhead, at a grazing angle, still gains a view that meets it from the side."""
     steep_measures: bool = True
     """With `steep_deg`, whether the steep band is a direction like the others (round 35) or measures no
     side (round 36): a steep ray then neither marks the side it meets as measured nor gains a view anything
@@ -246,7 +246,7 @@ class LookaheadPlanner(Planner):
         camera, center, options = world.camera, world.target.center(), self.options
         stride = max(1, round(camera.width / self.rays))
         grid = target_grid(world.target, OccupancyConfig(grid_resolution=self.grid, gain_ray_stride=stride,
-                                                         votes=options.votes, steep_deg=options.steep_deg))
+                                                         votes=options.votes), options.steep_deg)
         steps = replace(world.env, action_mode="forward", relative_step=FORWARD_STEP) if options.forward \
             else replace(world.env, action_mode="orbit", relative_step=ORBIT_STEP)
 

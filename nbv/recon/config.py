@@ -143,9 +143,6 @@ class OccupancyConfig:
     votes: bool = False
     """Weigh each image's hits against its rays' passes, one vote an image, instead of occupied winning
     (`nbv.recon.occupancy`; for stereo depth's false matches)."""
-    steep_deg: float = 0.0
-    """> 0: rays looking down more steeply than this many degrees are a sight direction of their own
-    (`OccupancyGrid`'s `steep_deg`; 0: none)."""
 
     def __post_init__(self) -> None:
         for name in ("grid_resolution", "gain_ray_stride", "integrate_ray_stride"):

@@ -187,6 +187,10 @@ class LookaheadOptions:
     """With `steep_deg`, whether the steep band is a direction like the others (round 35) or measures no
     side (round 36): a steep ray then neither marks the side it meets as measured nor gains a view anything
     for it (`side_columns`)."""
+    pace: bool = False
+    """The battery is spent at an even pace (round 38): the hinge charges each leg's metres past its share,
+    `battery(views)` times the legs flown with it over the flight's legs, not past the whole battery (else
+    the first views may spend it, leaving the last to crowd at the shortest step)."""
     ceiling_deg: float = 0.0
     """> 0: every step's elevation is held to at most this many degrees, in the look-ahead as in the flight
     (round 36): a view from nearly overhead sees walls at a grazing angle."""
@@ -273,6 +277,8 @@ class LookaheadPlanner(Planner):
         columns, ceiling = side_columns(grid, options), np.radians(options.ceiling_deg)
         looked = np.zeros(voxels, np.uint16)  # views flown that reached each voxel, still unknown
         count = self.view_count(views)
+        battery, legs = options.battery(count), max(count - 1, 1)
+        pace = battery / legs if options.pace else 0.0
         for left in range(count - 1, 0, -1):
             self.measure(world, grid, view)
             seen.clear()
@@ -285,8 +291,8 @@ class LookaheadPlanner(Planner):
             known, weights = side_items(grid, occupied, known, options.sides, columns)
             scores = expert_scores(view, known, sees, step, self.flight, left, options.horizon, DISCOUNT,
                                    flown_m=shell_path(chosen[0], chosen[1:]).total_m,
-                                   allowance_m=options.battery(count), excess_weight=options.excess,
-                                   weights=weights, total=voxels)
+                                   allowance_m=pace * len(chosen) if options.pace else battery,
+                                   excess_weight=options.excess, pace_m=pace, weights=weights, total=voxels)
             if options.masks:
                 ruled = np.array([ruled_out(step(action, view), chosen, options) for action in CANDIDATES])
                 scores = np.where(ruled, -np.inf, scores) if not ruled.all() else scores

@@ -72,13 +72,14 @@ def candidate_actions() -> np.ndarray:
 def expert_scores(view: Viewpoint, seen: np.ndarray, sees: Callable[[Viewpoint], np.ndarray],
                   step: Callable[[np.ndarray, Viewpoint], Viewpoint], flight_weight: float,
                   views_left: int, horizon: int, discount: float, *, flown_m: float = 0.0,
-                  allowance_m: float = 0.0, excess_weight: float = 0.0, weights: np.ndarray | None = None,
-                  total: int = 0) -> np.ndarray:
+                  allowance_m: float = 0.0, excess_weight: float = 0.0, pace_m: float = 0.0,
+                  weights: np.ndarray | None = None, total: int = 0) -> np.ndarray:
     """Every candidate action's score (module docstring), in `CANDIDATES`' order, from `view`, given the
     samples `seen` so far, what each view `sees`, how an action moves (`step(action, view)`), the flight-cost
     weight per metre, the views still to take, the horizon (0: all of them) and the discount (their defaults
     are `RewardConfig.teacher_horizon` and `teacher_discount`'s), and the hinge's terms (`flight_cost`:
-    metres flown so far, the allowance, the excess weight); float64 (125,), in coverage points. `weights`:
+    metres flown so far, the allowance, the excess weight; `pace_m`: the allowance grows by this much each leg
+    ahead, a battery spent evenly); float64 (125,), in coverage points. `weights`:
     each sample's worth (None: 1 each); `total`: the samples a coverage point is a hundredth of (0: all of
     `seen`)."""
     horizon = max(1, min(horizon or views_left, views_left))
@@ -95,7 +96,7 @@ def expert_scores(view: Viewpoint, seen: np.ndarray, sees: Callable[[Viewpoint],
             flown.append(here)
         legs = shell_path(view, flown).legs_m
         before = flown_m + np.cumsum([0.0, *legs[:-1]])  # the episode's metres as each leg starts
-        cost = sum(discount ** k * (flight_cost(flight_weight, b, m, allowance_m, excess_weight)
+        cost = sum(discount ** k * (flight_cost(flight_weight, b, m, allowance_m + k * pace_m, excess_weight)
                                     + TIE_BREAK_PER_M * m) for k, (b, m) in enumerate(zip(before, legs)))
         scores[i] = score - cost
     return scores

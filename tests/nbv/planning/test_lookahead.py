@@ -98,6 +98,16 @@ def test_a_battery_that_follows_the_views_grows_past_the_allowance_and_frees_the
         LookaheadOptions(battery_per_view_m=-1)
 
 
+def test_a_paced_battery_spends_an_even_share_a_leg_where_an_unpaced_one_spends_it_first_then_hovers():
+    world = PlanningWorld(config(), seed=3)
+    free = LookaheadPlanner(flight=0.0, grid=16, rays=8).plan(world, 3)
+    assert tiny(0.0, allowance_m=3.0, excess=0.0, pace=True).plan(world, 3) == free  # no hinge: no pace
+    first, hover = shell_path(world.start, tiny(0.0, allowance_m=3.0, excess=1e5).plan(world, 3)[1:]).legs_m
+    assert first > 1.5 and hover < 1e-9  # the free flight's first leg is 2.06 m: it takes what fits
+    paced = shell_path(world.start, tiny(0.0, allowance_m=3.0, excess=1e5, pace=True).plan(world, 3)[1:])
+    assert max(paced.legs_m) <= 1.5 and min(paced.legs_m) > 1.2  # 1.25 m each, half the battery a leg
+
+
 def test_with_patience_it_gives_up_on_what_it_looked_at_without_measuring():
     world = PlanningWorld(config(), seed=3)  # blank frames: stereo measures nothing, the grid stays unknown
     grid = target_grid(world.target, OccupancyConfig(grid_resolution=16))

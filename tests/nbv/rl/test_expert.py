@@ -230,3 +230,21 @@ def test_weighted_samples_count_their_worth_over_the_total_given():
                              weights=np.array([1.0, 0.5]), total=1)
     assert plain == pytest.approx(np.full(125, 100.0), abs=1e-4)
     assert weighted == pytest.approx(plain + 50.0, abs=1e-9)
+
+
+def test_a_paced_battery_charges_each_leg_past_its_share_of_it():
+    # Nothing to see: a score is minus its flight cost. A 90-degree turn at 2 m and 0.5 rad up is a leg of
+    # L = 2 cos(0.5) pi / 2 = 2.757 m along the shell; three of them (discount 0.9) against a 3 m battery
+    # charged 1 a metre past it pay 0.9 (2L - 3) + 0.81 L. Paced at 3 m a leg, no leg passes its share; at
+    # 2.5 m a leg the second passes 5.5 m by 2L - 5.5 and the third 8 m by 3L - 8.
+    nothing = lambda view: np.zeros(1, bool)  # noqa: E731
+    turn = candidate_actions().tolist().index([0.0, 1.0, 0.0])
+    leg = 2 * np.cos(0.5) * np.pi / 2
+
+    def cost(**pace: float) -> float:
+        return -expert_scores(START, np.zeros(1, bool), nothing, step, 0.0, 12, **TEACHER, allowance_m=3.0,
+                              excess_weight=1.0, **pace)[turn]
+
+    assert cost() == pytest.approx(0.9 * (2 * leg - 3) + 0.81 * leg, abs=1e-3)
+    assert cost(pace_m=3.0) == pytest.approx(0.0, abs=1e-4)
+    assert cost(pace_m=2.5) == pytest.approx(0.9 * (2 * leg - 5.5) + 0.81 * (3 * leg - 8), abs=1e-3)

@@ -135,6 +135,8 @@ INDEX = (
     Result("selection/round37/README.md", "selection/round37/steep60_blind/results.json", "its "
            "thirty-seventh round: round 36's blind steep band from start views never flown (adopted)",
            LOOKS_EVAL),
+    Result("selection/round38/README.md", "selection/round38/pace_starts0-5/results.json", "its "
+           "thirty-eighth round: a battery spent at an even pace (not adopted)", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

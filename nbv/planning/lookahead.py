@@ -57,7 +57,8 @@ nothing for the sides it meets steeply) or held every step under 45 degrees (`ce
 but not the courtyard gain its rule asked; round 37 confirmed the blind band from start views never flown
 (paper_results/selection/round37), so it is `lookahead-stereo`'s (`STEREO_STEEP`). Held out, scored once
 (paper_results/online/stereo, at 05e7f11): 4.4 points above the ring in 1.46x its metres, 3.9 above random
-views on the courtyard (the bar is 5), five of six checks as round 31's setting.
+views on the courtyard (the bar is 5), five of six checks as round 31's setting. Round 38
+(paper_results/selection/round38) spent the battery at an even pace (`pace`): both courtyards lower, so off.
 """
 
 from __future__ import annotations

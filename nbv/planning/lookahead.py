@@ -221,6 +221,15 @@ class LookaheadOptions:
         `battery_per_view_m` a view where that is more."""
         return max(self.allowance_m, self.battery_per_view_m * views)
 
+    def hinge(self, views: int, flown: int) -> tuple[float, float]:
+        """The hinge's allowance for the next leg of a flight of `views` views with `flown` legs behind it,
+        and how much it grows each leg after: with `pace` an even share of `battery` a leg, else all of it."""
+        battery = self.battery(views)
+        if not self.pace:
+            return battery, 0.0
+        share = battery / max(views - 1, 1)
+        return share * (flown + 1), share
+
     @property
     def masks(self) -> bool:
         """Whether a rule (`distinct`, `spacing_m`, `sight_deg`) may rule steps out (`ruled_out`)."""
@@ -278,8 +287,6 @@ class LookaheadPlanner(Planner):
         columns, ceiling = side_columns(grid, options), np.radians(options.ceiling_deg)
         looked = np.zeros(voxels, np.uint16)  # views flown that reached each voxel, still unknown
         count = self.view_count(views)
-        battery, legs = options.battery(count), max(count - 1, 1)
-        pace = battery / legs if options.pace else 0.0
         for left in range(count - 1, 0, -1):
             self.measure(world, grid, view)
             seen.clear()
@@ -290,9 +297,9 @@ class LookaheadPlanner(Planner):
                 looked += sees(view)[:voxels]
                 known |= looked >= options.patience
             known, weights = side_items(grid, occupied, known, options.sides, columns)
+            allowance, pace = options.hinge(count, len(chosen) - 1)
             scores = expert_scores(view, known, sees, step, self.flight, left, options.horizon, DISCOUNT,
-                                   flown_m=shell_path(chosen[0], chosen[1:]).total_m,
-                                   allowance_m=pace * len(chosen) if options.pace else battery,
+                                   flown_m=shell_path(chosen[0], chosen[1:]).total_m, allowance_m=allowance,
                                    excess_weight=options.excess, pace_m=pace, weights=weights, total=voxels)
             if options.masks:
                 ruled = np.array([ruled_out(step(action, view), chosen, options) for action in CANDIDATES])

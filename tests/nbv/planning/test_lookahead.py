@@ -106,6 +106,9 @@ def test_a_paced_battery_spends_an_even_share_a_leg_where_an_unpaced_one_spends_
     assert first > 1.5 and hover < 1e-9  # the free flight's first leg is 2.06 m: it takes what fits
     paced = shell_path(world.start, tiny(0.0, allowance_m=3.0, excess=1e5, pace=True).plan(world, 3)[1:])
     assert max(paced.legs_m) <= 1.5 and min(paced.legs_m) > 1.2  # 1.25 m each, half the battery a leg
+    assert LookaheadOptions(allowance_m=12.0, pace=True).hinge(13, 0) == (1.0, 1.0)  # 12 m over 12 legs
+    assert LookaheadOptions(allowance_m=12.0, pace=True).hinge(13, 11) == (12.0, 1.0)
+    assert LookaheadOptions(allowance_m=12.0).hinge(13, 0) == (12.0, 0.0)
 
 
 def test_with_patience_it_gives_up_on_what_it_looked_at_without_measuring():

@@ -68,9 +68,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from nbv.flight.path import azimuth_step, shell_path, shell_position
+from nbv.flight.path import shell_path
 from nbv.planning.base import Planner
 from nbv.planning.infogain import target_grid
+from nbv.planning.route import RouteSearch
+from nbv.planning.step_rules import ruled_out
 from nbv.recon.config import OccupancyConfig
 from nbv.recon.occupancy import OCCUPIED, UNKNOWN, OccupancyGrid
 from nbv.recon.stereo import StereoConfig, agreed_depth, box_stereo_depth, grayscale
@@ -192,6 +194,9 @@ class LookaheadOptions:
     """The battery is spent at an even pace (round 38): the hinge charges each leg's metres past its share,
     `battery(views)` times the legs flown with it over the flight's legs, not past the whole battery (else
     the first views may spend it, leaving the last to crowd at the shortest step)."""
+    route: bool = False
+    """With `forward`, every view still to take is chosen together, a route scored as one set and re-planned
+    at each view (`nbv.planning.route`; round 39), not each step by its look-ahead of `horizon` views."""
     ceiling_deg: float = 0.0
     """> 0: every step's elevation is held to at most this many degrees, in the look-ahead as in the flight
     (round 36): a view from nearly overhead sees walls at a grazing angle."""
@@ -211,6 +216,9 @@ class LookaheadOptions:
         if not 0 <= self.spacing_m < float("inf") or not 0 <= self.sight_deg < 180:
             raise ValueError(f"lookahead's spacing is a finite distance >= 0 and its sight rule 0 to 180 "
                              f"degrees (0: none), got {self.spacing_m}, {self.sight_deg}")
+        if self.route and (not self.forward or self.pace or self.masks):
+            raise ValueError("lookahead's route plans forward steps (forward) and takes neither pace nor a "
+                             "rule ruling steps out (distinct, spacing_m, sight_deg)")
         if not self.partners or not set(self.partners) <= set(PARTNER_SIDES) \
                 or not 0 <= self.agree <= len(self.partners):
             raise ValueError(f"lookahead-stereo's partners are sides from {PARTNER_SIDES} and agree 0 to "
@@ -283,7 +291,7 @@ class LookaheadPlanner(Planner):
             return replace(reached, elevation=min(reached.elevation, ceiling)) if options.ceiling_deg \
                 else reached
 
-        view, chosen, edge, occupied = world.start, [world.start], None, None
+        view, chosen, edge, occupied, route = world.start, [world.start], None, None, None
         columns, ceiling = side_columns(grid, options), np.radians(options.ceiling_deg)
         looked = np.zeros(voxels, np.uint16)  # views flown that reached each voxel, still unknown
         count = self.view_count(views)
@@ -298,9 +306,17 @@ class LookaheadPlanner(Planner):
                 known |= looked >= options.patience
             known, weights = side_items(grid, occupied, known, options.sides, columns)
             allowance, pace = options.hinge(count, len(chosen) - 1)
+            flown = shell_path(chosen[0], chosen[1:]).total_m
+            if options.route:
+                search = RouteSearch(view, left, sees, known, weights, step, self.flight, voxels,
+                                     flown_m=flown, allowance_m=allowance, excess=options.excess)
+                route = search.best(route[1:] if route else None)
+                view = search.next(route[0], view)
+                chosen.append(view)
+                continue
             scores = expert_scores(view, known, sees, step, self.flight, left, options.horizon, DISCOUNT,
-                                   flown_m=shell_path(chosen[0], chosen[1:]).total_m, allowance_m=allowance,
-                                   excess_weight=options.excess, pace_m=pace, weights=weights, total=voxels)
+                                   flown_m=flown, allowance_m=allowance, excess_weight=options.excess,
+                                   pace_m=pace, weights=weights, total=voxels)
             if options.masks:
                 ruled = np.array([ruled_out(step(action, view), chosen, options) for action in CANDIDATES])
                 scores = np.where(ruled, -np.inf, scores) if not ruled.all() else scores
@@ -365,34 +381,6 @@ def stereo_partner(view: Viewpoint, baseline: float = STEREO_BASELINE_M, side: s
     horizontal = max(view.radius * np.cos(view.elevation), baseline)
     turn = 2 * np.arcsin(baseline / (2 * horizontal))
     return Viewpoint(view.radius, view.azimuth + (turn if side == "forward" else -turn), view.elevation)
-
-
-def revisits(view: Viewpoint, flown: list[Viewpoint], tolerance: float = 1e-6) -> bool:
-    """Whether `view` is one of the views `flown` (radius, azimuth across 2 pi, elevation within
-    `tolerance`)."""
-    return any(abs(view.radius - f.radius) <= tolerance and abs(view.elevation - f.elevation) <= tolerance
-               and abs(azimuth_step(f.azimuth, view.azimuth)) <= tolerance for f in flown)
-
-
-def crowds(view: Viewpoint, flown: list[Viewpoint], spacing_m: float) -> bool:
-    """Whether `view`'s camera lies within `spacing_m` metres (a straight line) of a view `flown`'s."""
-    here = shell_position(*view.as_array())
-    return any(np.linalg.norm(here - shell_position(*f.as_array())) < spacing_m for f in flown)
-
-
-def shares_sight(view: Viewpoint, flown: list[Viewpoint], degrees: float) -> bool:
-    """Whether `view`'s sight line (the unit direction from the aim point to its camera) lies within
-    `degrees` of a view `flown`'s, whatever the radii."""
-    here, least = shell_position(1.0, view.azimuth, view.elevation), np.cos(np.radians(degrees))
-    return any(np.dot(here, shell_position(1.0, f.azimuth, f.elevation)) > least for f in flown)
-
-
-def ruled_out(view: Viewpoint, flown: list[Viewpoint], options: LookaheadOptions) -> bool:
-    """Whether `options` rule a step to `view` out after the views `flown`: within `spacing_m` of one
-    (`crowds`), within `sight_deg` of one's sight line (`shares_sight`), or one of them (`distinct`)."""
-    return bool(options.spacing_m and crowds(view, flown, options.spacing_m)) \
-        or bool(options.sight_deg and shares_sight(view, flown, options.sight_deg)) \
-        or (options.distinct and revisits(view, flown))
 
 
 def lookahead_planner(settings: PlanSettings, seed: int, argument: str | None) -> LookaheadPlanner:

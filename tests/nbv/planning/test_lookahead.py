@@ -23,15 +23,13 @@ from nbv.planning.lookahead import (
     STEREO_STEEP,
     LookaheadOptions,
     LookaheadPlanner,
-    crowds,
     lookahead_planner,
-    revisits,
-    shares_sight,
     side_columns,
     stereo_lookahead_planner,
     stereo_partner,
 )
 from nbv.planning.registry import make_planner
+from nbv.planning.step_rules import crowds, revisits, shares_sight
 from nbv.planning.world import PlanningWorld
 from nbv.recon.config import OccupancyConfig
 from nbv.recon.occupancy import UNKNOWN, OccupancyGrid

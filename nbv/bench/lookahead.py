@@ -6,7 +6,8 @@ flying on: measuring (the depth camera's image, or the second frames' renders an
 scoring the 125 candidate steps on the grid. Stereo with three second frames (back, forward, up; round 26)
 is measured beside one (round 25), so the price of each added frame is a ratio from the same run; both step
 forward (round 28). `lookahead-stereo` itself (one frame, forward, valuing sides never measured under a
-battery's hinge; round 31) is timed beside round 28's setting, so the sides term's price is a ratio too.
+battery's hinge, round 31; the rest of the flight planned as one route, round 39) is timed beside round 28's
+setting, so the price of those terms is a ratio too.
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ PLANNERS = {
     "depth camera": LookaheadPlanner(),
     "stereo, one second frame (back; round 28's setting)": LookaheadPlanner(
         depth="stereo", options=LookaheadOptions(forward=STEREO_FORWARD)),
-    "lookahead-stereo (one frame, sides never measured, hinge; round 31)": stereo_lookahead_planner(
+    "lookahead-stereo (one frame, sides never measured, hinge, route; round 39)": stereo_lookahead_planner(
         PlanSettings(), 0, None),
     "stereo, three second frames (back, forward, up)": LookaheadPlanner(
         depth="stereo", options=LookaheadOptions(partners=("back", "forward", "up"), forward=STEREO_FORWARD)),
@@ -53,7 +54,7 @@ def seconds_a_view(planner: LookaheadPlanner, views: int) -> float:
 
 def run(quick: bool) -> list[BenchResult]:
     """Seconds a view of each look-ahead, and the stereo ones' ratios to the depth camera's and each other
-    (the sides term's price: `lookahead-stereo` over round 28's setting)."""
+    (the sides and route terms' price: `lookahead-stereo` over round 28's setting)."""
     set_torch_threads(1)
     views = 3 if quick else 9
     seconds = {label: seconds_a_view(planner, views) for label, planner in PLANNERS.items()}
@@ -62,6 +63,6 @@ def run(quick: bool) -> list[BenchResult]:
     camera, one, sides, three = seconds.values()
     results.append(BenchResult("lookahead", "stereo (one frame) / depth camera", one / camera, "x"))
     results.append(BenchResult("lookahead", "stereo three frames / one frame", three / one, "x"))
-    results.append(BenchResult("lookahead", "lookahead-stereo (sides) / round 28's setting", sides / one,
-                               "x"))
+    results.append(BenchResult("lookahead", "lookahead-stereo (sides, route) / round 28's setting",
+                               sides / one, "x"))
     return results

@@ -32,5 +32,5 @@ def test_bench_times_the_look_aheads_side_by_side(tmp_path):
     assert len(seconds) == 4 and all(s > 0 for s in seconds)
     three = results["stereo three frames / one frame"]["value"]
     assert three > 1.0  # two more renders and sweeps a view cost time
-    assert results["lookahead-stereo (sides) / round 28's setting"]["value"] > 0
+    assert results["lookahead-stereo (sides, route) / round 28's setting"]["value"] > 0
 

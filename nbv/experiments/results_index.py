@@ -132,6 +132,8 @@ INDEX = (
            LOOKS_EVAL),
     Result("selection/round38/README.md", "selection/round38/pace_starts0-5/results.json", "its "
            "thirty-eighth round: a battery spent at an even pace (not adopted)", LOOKS_EVAL),
+    Result("selection/round39/README.md", "selection/round39/route_starts0-5/results.json", "its "
+           "thirty-ninth round: the rest of the flight planned as one route (adopted)", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

@@ -111,7 +111,8 @@ PLANNERS: tuple[PlannerEntry, ...] = (
                  depth_option=True),
     PlannerEntry("lookahead-stereo", "the same look-ahead on what a camera alone measures, flying a "
                  "pilot's orbit: each step 27.7 to 55.4 degrees forward round the target, its radius and "
-                 "elevation the look-ahead's choice; the grid fused from plane-sweep stereo depth of each "
+                 "elevation chosen with every view still to take as one route, planned again at each view; "
+                 "the grid fused from plane-sweep stereo depth of each "
                  "view and a second frame 0.25 m back along its orbit (reads images and poses, as the "
                  "policies do), valuing the sides of surface it has not yet measured (rays over 60 degrees "
                  "down measure none), less 0.1 a metre and 2 a metre more past a battery of 13 m, one more a "

@@ -75,7 +75,7 @@ import numpy as np
 from nbv.flight.path import shell_path
 from nbv.planning.base import Planner
 from nbv.planning.infogain import target_grid
-from nbv.planning.route import RouteSearch
+from nbv.planning.route import RouteSearch, view_key
 from nbv.planning.step_rules import ruled_out
 from nbv.recon.config import OccupancyConfig
 from nbv.recon.occupancy import OCCUPIED, UNKNOWN, OccupancyGrid
@@ -284,7 +284,7 @@ class LookaheadPlanner(Planner):
         voxels = grid.state.size
 
         def sees(view: Viewpoint) -> np.ndarray:
-            key = (round(view.radius, 9), round(view.azimuth % (2 * np.pi), 9), round(view.elevation, 9))
+            key = view_key(view)
             if key not in seen:
                 seen[key], sighted = grid.look(camera.K, viewpoint_to_c2w(view, center), camera.width,
                                                camera.height, stride, options.frontier, bool(options.sides))

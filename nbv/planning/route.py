@@ -144,8 +144,9 @@ class RouteSearch:
                     moved = self.next(action, before)
                     return self.gain(moved) - self.cost([*views[:k], moved, *views[k + 1:]])
 
-                best = max(options, key=worth)
-                if best != route[k] and worth(best) > worth(route[k]) + 1e-9:
+                worths = {action: worth(action) for action in options}  # the current step is among them
+                best = max(options, key=worths.__getitem__)
+                if best != route[k] and worths[best] > worths[route[k]] + 1e-9:
                     if k + 1 < len(route):
                         r, a, e = route[k + 1]
                         route[k + 1] = (r, route[k][1] + a - best[1], e)

@@ -24,7 +24,8 @@ Round 35: `--steep D` gives rays looking down more steeply than D degrees sight 
 round 36: `--steep-blind` makes that band measure no side instead (_stpDb); `--ceiling C` holds every step at
 or under C degrees of elevation (_ceC). Round 38: `--pace` charges the hinge on each leg's metres past an
 even share of the battery (_pc). Round 39: `--route` plans every view still to take together as one
-route, re-planned at each view (_rt).
+route, re-planned at each view (_rt). Round 40: `--restarts N` also improves N routes of random steps
+(_rsN).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -104,12 +105,14 @@ def arguments() -> argparse.Namespace:
                         help="the hinge charges each leg past an even share of the battery (round 38)")
     parser.add_argument("--route", action="store_true",
                         help="plan every view still to take together, re-planned at each view (round 39)")
+    parser.add_argument("--restarts", type=int, default=0,
+                        help="with --route, also improve this many routes of random steps (round 40)")
     looks_eval.study_arguments(parser)
     return parser.parse_args()
 
 
 def named(options: LookaheadOptions) -> str:
-    """A run's name ending for `options`' variants (rounds 27 to 39), empty for the teacher's own."""
+    """A run's name ending for `options`' variants (rounds 27 to 40), empty for the teacher's own."""
     o = options
     return (f"_f{o.frontier}" if o.frontier else "") \
         + (f"_h{o.allowance_m:g}x{o.excess:g}" if o.excess else "") \
@@ -120,7 +123,7 @@ def named(options: LookaheadOptions) -> str:
         + (f"_si{o.sight_deg:g}" if o.sight_deg else "") + (f"_sd{o.sides:g}" if o.sides else "") \
         + (f"_stp{o.steep_deg:g}" + "b" * (not o.steep_measures) if o.steep_deg else "") \
         + (f"_ce{o.ceiling_deg:g}" if o.ceiling_deg else "") + ("_pc" if o.pace else "") \
-        + ("_rt" if o.route else "")
+        + ("_rt" if o.route else "") + (f"_rs{o.restarts}" if o.restarts else "")
 
 
 def stereo_suffix(paired: LookaheadOptions) -> str:
@@ -142,7 +145,7 @@ def main() -> None:
                                forward=args.forward, spacing_m=args.spacing, sight_deg=args.sight,
                                sides=args.sides, battery_per_view_m=args.per_view, steep_deg=args.steep,
                                steep_measures=not args.steep_blind, ceiling_deg=args.ceiling, pace=args.pace,
-                               route=args.route)
+                               route=args.route, restarts=args.restarts)
     paired = replace(options, partners=tuple(args.partners), agree=args.agree, votes=args.votes)
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"

@@ -205,6 +205,9 @@ class LookaheadOptions:
     route: bool = False
     """With `forward`, every view still to take is chosen together, a route scored as one set and re-planned
     at each view (`nbv.planning.route`; round 39), not each step by its look-ahead of `horizon` views."""
+    restarts: int = 0
+    """With `route`, the route's search also improves this many routes of random steps, keeping the best
+    (`RouteSearch.best`; round 40)."""
     ceiling_deg: float = 0.0
     """> 0: every step's elevation is held to at most this many degrees, in the look-ahead as in the flight
     (round 36): a view from nearly overhead sees walls at a grazing angle."""
@@ -227,6 +230,9 @@ class LookaheadOptions:
         if self.route and (not self.forward or self.pace or self.masks):
             raise ValueError("lookahead's route plans forward steps (forward) and takes neither pace nor a "
                              "rule ruling steps out (distinct, spacing_m, sight_deg)")
+        if self.restarts < 0 or (self.restarts and not self.route):
+            raise ValueError(f"lookahead's restarts are a count >= 0 of random routes its route's search "
+                             f"improves (route), got {self.restarts}")
         if not self.partners or not set(self.partners) <= set(PARTNER_SIDES) \
                 or not 0 <= self.agree <= len(self.partners):
             raise ValueError(f"lookahead-stereo's partners are sides from {PARTNER_SIDES} and agree 0 to "
@@ -318,7 +324,7 @@ class LookaheadPlanner(Planner):
             if options.route:
                 search = RouteSearch(view, left, sees, known, weights, step, self.flight, voxels,
                                      flown_m=flown, allowance_m=allowance, excess=options.excess)
-                route = search.best(route[1:] if route else None)
+                route = search.best(route[1:] if route else None, options.restarts)
                 view = search.next(route[0], view)
                 chosen.append(view)
                 continue

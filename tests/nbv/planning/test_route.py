@@ -82,3 +82,25 @@ def test_a_route_flight_steps_forward_and_flies_otherwise_than_the_look_ahead():
 def test_a_route_plans_forward_steps_alone(options):
     with pytest.raises(ValueError, match="route plans forward steps .forward. and takes neither pace nor"):
         LookaheadOptions(route=True, **options)
+
+
+def test_restarts_find_a_shorter_sweep_that_one_view_changes_cannot():
+    """W known, three views: the greedy route sees X at 34.6 degrees and V at 83.1, then steps 27.7 more.
+    A one-view change hands its advance to the next view and the last already takes the shortest step, so
+    the search cannot shorten the 110.8-degree sweep; a random start improved sweeps 83.1 (27.7 each), its
+    last view at 10 degrees seeing X and V at once."""
+    routes = RouteSearch(START, 3, sees, np.array([False, True, False]), WORTH, step, 1.0, 1)
+    restarted = routes.best(restarts=8)
+    sweep = [round(np.degrees(routes.views(r)[-1].azimuth), 1) for r in (routes.best(), restarted)]
+    assert sweep == [110.8, 83.1]
+    metres = shell_path(START, routes.views(restarted)).total_m
+    assert routes.score(restarted) == pytest.approx(100 * 5.0 - (1.0 + TIE_BREAK_PER_M) * metres)
+    assert routes.score(restarted) > routes.score(routes.best()) + 0.5
+    assert routes.best(restarts=8) == restarted  # seeded by the views left: a flight repeats itself
+
+
+@pytest.mark.parametrize("options", [{"restarts": 2, "forward": True}, {"restarts": -1, "forward": True,
+                                                                         "route": True}])
+def test_restarts_are_a_count_for_a_route(options):
+    with pytest.raises(ValueError, match="restarts are a count >= 0 of random routes"):
+        LookaheadOptions(**options)

@@ -150,7 +150,7 @@ class RouteSearch:
                     return self.gain(moved) - self.cost([*views[:k], moved, *views[k + 1:]])
 
                 worths = {action: worth(action) for action in options}  # the current step is among them
-                best = max(options, key=worths.__getitem__)
+                best = max(worths, key=worths.__getitem__)
                 if best != route[k] and worths[best] > worths[route[k]] + 1e-9:
                     if k + 1 < len(route):
                         r, a, e = route[k + 1]

@@ -27,11 +27,6 @@ INDEX = (
            "(ours, the paper preset's)", "make tables"),
     Result("budget/budget.md", "budget/budget.json", "coverage against view budget and metres flown, AUC",
            "make tables"),
-    Result("budget_lookahead/budget.md", "budget_lookahead/budget.json", "lookahead-stereo against view "
-           "budget and metres flown beside the tuned rings and random views (the budget part's settings, no "
-           "oracle; round 39's route, newer than budget/)",
-           "nbv tables --part budget --planners random orbit orbit2 lookahead-stereo --out OUT "
-           "(OUT/budget/)"),
     Result("online/online.md", "online/online.json", "the shipped policy and the paper "
            "preset's against the baselines, 13 views, five held-out buildings, one pass",
            "nbv online (command in the file)"),

@@ -136,6 +136,8 @@ INDEX = (
            "thirty-ninth round: the rest of the flight planned as one route (adopted)", LOOKS_EVAL),
     Result("selection/round40/README.md", "selection/round40/restarts_starts0-5/results.json", "its "
            "fortieth round: the route's search started again from random routes (not adopted)", LOOKS_EVAL),
+    Result("selection/round41/README.md", "selection/round41/grid64_starts0-5/results.json", "its "
+           "forty-first round: a 64-voxel gain grid (not adopted, stopped early)", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

@@ -1,8 +1,9 @@
 """Which true surface one planner's views see and another's miss, by how it faces (round 27's diagnostic).
 
 Reads two planners' flights on one validation building from a `looks_eval` work folder (the viewpoints each
-run flew, `WORK/NAME/SCENE.json`), and for every start view scores them as the studies do: the samples of
-the target's true surface (`nbv.recon.visibility.scene_visibility`, the same seed) that some view sees.
+run flew, `WORK/NAME/SCENE.json`) or from studies' committed results (`--results`), and for every start view
+scores them as the studies do: the samples of the target's true surface
+(`nbv.recon.visibility.scene_visibility`, the same seed) that some view sees.
 Each sample is told by its face's normal: a roof (pointing up), an outer wall (facing away from the
 building's vertical axis), an inner wall (facing it: a courtyard's, a U's), or other. The table gives, per
 start view, each planner's coverage, how many samples the baseline sees that the planner misses and the
@@ -11,6 +12,9 @@ from above, the samples the planner misses (red) and sees alone (blue) on the fi
 
     python scripts/missed_surface.py --work WORK --scene family:9 \
         --planner depth-teacher_r48_s4_w0.1_stereo --baseline orbit --out OUT
+    python scripts/missed_surface.py --results paper_results/selection/round39/route_starts*/results.json \
+        --scene family:39 --planner depth-teacher_r48_s4_w0.1_stereo_h13x2_fw_sd1_stp60b_rt \
+        --baseline orbit2 --seeds 0 1 2 3 4 5 6 7 8 --out OUT
 """
 
 from __future__ import annotations
@@ -118,9 +122,31 @@ def where(part: dict) -> str:
     return "-" if part["median_z_m"] is None else f"{part['median_z_m']:.2f} / {part['median_radius_m']:.2f}"
 
 
+def worked(work: Path, name: str, scene: str) -> dict:
+    """One planner's runs on `scene` by start view, from a `looks_eval` work folder."""
+    saved = looks_eval.work_file(work, name, scene)
+    if not saved.is_file():
+        raise SystemExit(f"no flights of {name} on {scene} in {work} ({saved.name} missing)")
+    return json.loads(saved.read_text())["result"]["runs"]
+
+
+def studied(files: list[Path], name: str, scene: str) -> dict:
+    """One planner's runs on `scene` by start view, merged from studies' results.json (`write_study`)."""
+    runs = {}
+    for path in files:
+        doc = json.loads(path.read_text())["results"].get(name, {}).get("runs", {})
+        runs |= doc.get(scene, {}).get("runs", {})
+    if not runs:
+        raise SystemExit(f"no flights of {name} on {scene} in {', '.join(map(str, files))}")
+    return runs
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--work", type=Path, required=True, help="a looks_eval work folder")
+    source = parser.add_mutually_exclusive_group(required=True)
+    source.add_argument("--work", type=Path, help="a looks_eval work folder")
+    source.add_argument("--results", type=Path, nargs="+",
+                        help="instead, studies' results.json files (their start views merged)")
     parser.add_argument("--scene", required=True)
     parser.add_argument("--planner", required=True, help="the planner's name in the work folder")
     parser.add_argument("--baseline", default="orbit")
@@ -128,12 +154,9 @@ def main() -> None:
     parser.add_argument("--out", type=Path, required=True)
     args = parser.parse_args()
     looks_eval.refuse_held_out([args.scene])
-    flights = {}
-    for role, name in (("planner", args.planner), ("baseline", args.baseline)):
-        saved = looks_eval.work_file(args.work, name, args.scene)
-        if not saved.is_file():
-            raise SystemExit(f"no flights of {name} on {args.scene} in {args.work} ({saved.name} missing)")
-        flights[role] = json.loads(saved.read_text())["result"]["runs"]
+    flights = {role: (studied(args.results, name, args.scene) if args.results
+                      else worked(args.work, name, args.scene))
+               for role, name in (("planner", args.planner), ("baseline", args.baseline))}
     with atomic_folder(args.out, overwrite=True, outputs=("results.json", "results.md", "missed.png")) as out:
         rows = compare(args.scene, flights, args.seeds, out / "missed.png")
         text = table(rows)

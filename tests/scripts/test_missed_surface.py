@@ -53,3 +53,21 @@ def test_the_script_compares_two_flights_and_refuses_held_out_or_missing_ones(tm
     assert "held-out buildings are not for choosing: alpine_chalet" in refused.stderr
     missing = run("--work", str(tmp_path), "--scene", "family:4", "--planner", "top", "--out", "x")
     assert "no flights of top on family:4" in missing.stderr
+
+
+def test_the_script_reads_flights_from_studies_results_merging_their_start_views(tmp_path):
+    low = [[1.5, a, np.radians(5)] for a in (0.0, 2.1, 4.2)]
+    top = [[1.5, 0.0, np.radians(80)]]
+    files = []
+    for seed in (0, 1):
+        study = {name: {"runs": {"family:9": {"runs": {str(seed): {"viewpoints": views}}}}}
+                 for name, views in (("low", low), ("top", top))}
+        files.append(tmp_path / f"study{seed}.json")
+        files[-1].write_text(json.dumps({"results": study}))
+    done = run("--results", *map(str, files), "--scene", "family:9", "--planner", "top", "--baseline", "low",
+               "--seeds", "0", "1", "--out", str(tmp_path / "out"))
+    assert done.returncode == 0, done.stderr
+    rows = json.loads((tmp_path / "out" / "results.json").read_text())["rows"]
+    assert [r["seed"] for r in rows] == [0, 1] and all(r["missed"]["count"] > 0 for r in rows)
+    missing = run("--results", str(files[0]), "--scene", "family:9", "--planner", "nobody", "--out", "x")
+    assert "no flights of nobody on family:9 in" in missing.stderr

@@ -160,7 +160,8 @@ def main() -> None:
     with atomic_folder(args.out, overwrite=True, outputs=("results.json", "results.md", "missed.png")) as out:
         rows = compare(args.scene, flights, args.seeds, out / "missed.png")
         text = table(rows)
-        command = portable_record({k: str(v) for k, v in vars(args).items()})
+        command = portable_record({k: " ".join(map(str, v)) if isinstance(v, list) else str(v)
+                                   for k, v in vars(args).items()})
         write_json(out / "results.json", {"command": command, "commit": git_commit(), "rows": rows})
         write_text(out / "results.md", f"# What {args.planner} misses of what {args.baseline} sees on "
                    f"{args.scene}\n\nSamples of the true surface (of 20000) by start view.\n\n{text}\n"

@@ -138,6 +138,9 @@ INDEX = (
            "fortieth round: the route's search started again from random routes (not adopted)", LOOKS_EVAL),
     Result("selection/round41/README.md", "selection/round41/grid64_starts0-5/results.json", "its "
            "forty-first round: a 64-voxel gain grid (not adopted, stopped early)", LOOKS_EVAL),
+    Result("selection/round42/README.md", "selection/round42/bound/results.json", "its forty-second round, "
+           "a diagnostic: lookahead-stereo's route on the true surface, at 13, 15 and 17 m of battery",
+           "python scripts/route_bound.py (commands in the file)"),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

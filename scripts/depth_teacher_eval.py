@@ -37,7 +37,6 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from common.io import atomic_folder
 from nbv.planning.config import PlanSettings
 from nbv.planning.lookahead import (
     HORIZON,
@@ -165,12 +164,8 @@ def main() -> None:
                 names.append(flown)
     results = looks_eval.evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work,
                                   blanks=blanks)
-    checks = looks_eval.policy_acceptance(results, args.scenes, names)
-    table = looks_eval.report(results, args.scenes, args.seeds, args.views, "orbit", checks)
-    with atomic_folder(args.out, overwrite=True, outputs=looks_eval.STUDY_OUTPUTS) as out:
-        looks_eval.write_study(out, args, results, checks, table,
-                               f"{args.views} views: the teacher's look-ahead on depth vs the tuned orbit")
-    print(table)
+    looks_eval.conclude(args, results, names,
+                        f"{args.views} views: the teacher's look-ahead on depth vs the tuned orbit")
 
 
 if __name__ == "__main__":

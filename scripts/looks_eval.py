@@ -246,6 +246,17 @@ def write_study(out: Path, args: argparse.Namespace, results: dict, checks: dict
         "results": results, "checks": checks, "command": sys.argv}))
 
 
+def conclude(args: argparse.Namespace, results: dict, names: list[str], title: str) -> str:
+    """A study's end: the checks of the planners `names`, the table against the tuned orbit, the output
+    folder (`write_study`, its chart titled `title`); the table, printed and returned."""
+    checks = policy_acceptance(results, args.scenes, names)
+    table = report(results, args.scenes, args.seeds, args.views, "orbit", checks)
+    with atomic_folder(args.out, overwrite=True, outputs=STUDY_OUTPUTS) as out:
+        write_study(out, args, results, checks, table, title)
+    print(table)
+    return table
+
+
 def study_arguments(parser: argparse.ArgumentParser) -> None:
     """The options every validation study of this kind takes: buildings, start views, views, out, work."""
     parser.add_argument("--scenes", nargs="+", default=list(SCENES))

@@ -141,28 +141,43 @@ def studied(files: list[Path], name: str, scene: str) -> dict:
     return runs
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def flight_arguments(parser: argparse.ArgumentParser, baseline: str) -> None:
+    """The options of a diagnostic comparing two planners' flights on one building (`baseline`: default)."""
     source = parser.add_mutually_exclusive_group(required=True)
     source.add_argument("--work", type=Path, help="a looks_eval work folder")
     source.add_argument("--results", type=Path, nargs="+",
                         help="instead, studies' results.json files (their start views merged)")
     parser.add_argument("--scene", required=True)
     parser.add_argument("--planner", required=True, help="the planner's name in the work folder")
-    parser.add_argument("--baseline", default="orbit")
+    parser.add_argument("--baseline", default=baseline)
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4, 5])
     parser.add_argument("--out", type=Path, required=True)
-    args = parser.parse_args()
+
+
+def read_flights(args: argparse.Namespace) -> dict[str, dict]:
+    """The planner's and the baseline's runs (`flight_arguments`), by role; held-out buildings refused."""
     looks_eval.refuse_held_out([args.scene])
-    flights = {role: (studied(args.results, name, args.scene) if args.results
-                      else worked(args.work, name, args.scene))
-               for role, name in (("planner", args.planner), ("baseline", args.baseline))}
+    return {role: (studied(args.results, name, args.scene) if args.results
+                   else worked(args.work, name, args.scene))
+            for role, name in (("planner", args.planner), ("baseline", args.baseline))}
+
+
+def command_record(args: argparse.Namespace) -> dict:
+    """The command line as a results file records it: each option's value, lists space-separated."""
+    return portable_record({k: " ".join(map(str, v)) if isinstance(v, list) else str(v)
+                            for k, v in vars(args).items()})
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    flight_arguments(parser, "orbit")
+    args = parser.parse_args()
+    flights = read_flights(args)
     with atomic_folder(args.out, overwrite=True, outputs=("results.json", "results.md", "missed.png")) as out:
         rows = compare(args.scene, flights, args.seeds, out / "missed.png")
         text = table(rows)
-        command = portable_record({k: " ".join(map(str, v)) if isinstance(v, list) else str(v)
-                                   for k, v in vars(args).items()})
-        write_json(out / "results.json", {"command": command, "commit": git_commit(), "rows": rows})
+        record = {"command": command_record(args), "commit": git_commit(), "rows": rows}
+        write_json(out / "results.json", record)
         write_text(out / "results.md", f"# What {args.planner} misses of what {args.baseline} sees on "
                    f"{args.scene}\n\nSamples of the true surface (of 20000) by start view.\n\n{text}\n"
                    "![from above](missed.png)\n")

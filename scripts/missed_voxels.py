@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
-from common.provenance import git_commit, portable_record
+from common.provenance import git_commit
 from nbv.planning.infogain import target_grid
 from nbv.planning.lookahead import LOOKAHEAD_GRID, STEREO_STEEP
 from nbv.planning.world import PlanningWorld
@@ -34,8 +34,7 @@ from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes.spec import SceneSet
 
 sys.path.insert(0, str(Path(__file__).parent))
-import looks_eval  # noqa: E402
-from missed_surface import studied, worked  # noqa: E402
+from missed_surface import command_record, flight_arguments, read_flights  # noqa: E402
 
 STATES = {"unknown": UNKNOWN, "free": FREE, "occupied": OCCUPIED}
 """The voxel states counted, by name."""
@@ -79,26 +78,15 @@ def start_row(scene: str, flights: dict[str, dict], seed: int) -> dict:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    source = parser.add_mutually_exclusive_group(required=True)
-    source.add_argument("--work", type=Path, help="a looks_eval work folder")
-    source.add_argument("--results", type=Path, nargs="+", help="instead, studies' results.json files")
-    parser.add_argument("--scene", required=True)
-    parser.add_argument("--planner", required=True, help="the planner's name in the work folder")
-    parser.add_argument("--baseline", default="orbit2")
-    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4, 5])
-    parser.add_argument("--out", type=Path, required=True)
+    flight_arguments(parser, "orbit2")
     args = parser.parse_args()
-    looks_eval.refuse_held_out([args.scene])
-    flights = {role: (studied(args.results, name, args.scene) if args.results
-                      else worked(args.work, name, args.scene))
-               for role, name in (("planner", args.planner), ("baseline", args.baseline))}
+    flights = read_flights(args)
     rows = [start_row(args.scene, flights, seed) for seed in args.seeds]
     head = ["start", "missed", *STATES, "occupied, its quadrant measured"]
     text = markdown_table(head, [[r[k] for k in ("seed", "missed", *head[2:])] for r in rows])
     with atomic_folder(args.out, overwrite=True, outputs=("results.json", "results.md")) as out:
-        command = portable_record({k: " ".join(map(str, v)) if isinstance(v, list) else str(v)
-                                   for k, v in vars(args).items()})
-        write_json(out / "results.json", {"command": command, "commit": git_commit(), "rows": rows})
+        record = {"command": command_record(args), "commit": git_commit(), "rows": rows}
+        write_json(out / "results.json", record)
         write_text(out / "results.md", f"# Where {args.planner} keeps what it misses of {args.baseline}'s "
                    f"surface on {args.scene}\n\nSamples of the true surface (of 20000) the baseline sees and "
                    f"the planner misses, by the state of their voxel in the planner's grid fused from exact "

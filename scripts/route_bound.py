@@ -22,7 +22,6 @@ from pathlib import Path
 
 import numpy as np
 
-from common.io import atomic_folder
 from nbv.flight.path import shell_path
 from nbv.planning.base import Planner
 from nbv.planning.config import PlanSettings
@@ -92,12 +91,8 @@ def main() -> None:
     planners |= {name: (RouteBound(m), False) for name, m in zip(names, args.battery, strict=True)}
     results = looks_eval.evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work,
                                   blank_images=False)
-    checks = looks_eval.policy_acceptance(results, args.scenes, names)
-    table = looks_eval.report(results, args.scenes, args.seeds, args.views, "orbit", checks)
-    with atomic_folder(args.out, overwrite=True, outputs=looks_eval.STUDY_OUTPUTS) as out:
-        looks_eval.write_study(out, args, results, checks, table,
-                               f"{args.views} views: lookahead-stereo's route on the true surface")
-    print(table)
+    looks_eval.conclude(args, results, names,
+                        f"{args.views} views: lookahead-stereo's route on the true surface")
 
 
 if __name__ == "__main__":

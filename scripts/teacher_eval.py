@@ -20,7 +20,6 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from common.io import atomic_folder
 from nbv.experiments.online_acceptance import building_mean
 from nbv.planning.config import PlanSettings
 from nbv.planning.registry import make_planner
@@ -30,16 +29,7 @@ from nbv.rl.expert import EXPERT_KEY
 from nbv.rl.presets import looks_preset
 
 sys.path.insert(0, str(Path(__file__).parent))
-from looks_eval import (  # noqa: E402
-    STUDY_OUTPUTS,
-    EnvPlanner,
-    evaluate,
-    policy_acceptance,
-    refuse_held_out,
-    report,
-    study_arguments,
-    write_study,
-)
+from looks_eval import EnvPlanner, conclude, evaluate, refuse_held_out, study_arguments  # noqa: E402
 
 
 class TeacherPlanner(EnvPlanner):
@@ -90,11 +80,8 @@ def main() -> None:
                              teacher_discount=args.teacher_discount)
         planners[f"{teacher}_w{w:g}{hinge}"] = (TeacherPlanner(trained, terms), False)
     results = evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work)
-    checks = policy_acceptance(results, args.scenes, [name for name in planners if name.startswith(teacher)])
-    table = report(results, args.scenes, args.seeds, args.views, "orbit", checks)
-    with atomic_folder(args.out, overwrite=True, outputs=STUDY_OUTPUTS) as out:
-        write_study(out, args, results, checks, table, f"{args.views} views: the teacher vs the tuned orbit")
-    print(table)
+    conclude(args, results, [name for name in planners if name.startswith(teacher)],
+             f"{args.views} views: the teacher vs the tuned orbit")
     print("mean coverage:", {n: round(building_mean(d["summary"]["coverage"]), 1)
                              for n, d in results.items()})
 

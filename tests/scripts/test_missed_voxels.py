@@ -1,11 +1,15 @@
 """The missed-voxels diagnostic's count on a hand-made grid: each state, and an occupied voxel's side counted
-as measured only from the quadrant its sample's face looks out to."""
+as measured only from the quadrant its sample's face looks out to; the script's refusals."""
 
 from __future__ import annotations
+
+import subprocess
+import sys
 
 import numpy as np
 
 from nbv.recon.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, sight_bin
+from scripts import missed_voxels
 from scripts.missed_voxels import voxel_states
 
 
@@ -24,3 +28,14 @@ def test_states_and_the_occupied_measured_from_the_faces_quadrant():
     steep.sides[1] = 1 << int(sight_bin(np.array([-0.8, 0, -0.6]), 60))  # down, not steeply
     counted = voxel_states(steep, samples[:2], normals[:2])["occupied, its quadrant measured"]
     assert counted == 1  # the steep band measures no side
+
+
+def test_the_script_refuses_held_out_buildings_and_flights_it_does_not_have(tmp_path):
+    def run(*args: str) -> subprocess.CompletedProcess:
+        return subprocess.run([sys.executable, missed_voxels.__file__, *args], capture_output=True, text=True,
+                              check=False)
+
+    refused = run("--work", str(tmp_path), "--scene", "imperial_temple", "--planner", "p", "--out", "x")
+    assert "held-out buildings are not for choosing: imperial_temple" in refused.stderr
+    missing = run("--work", str(tmp_path), "--scene", "family:9", "--planner", "p", "--out", "x")
+    assert "no flights of p on family:9" in missing.stderr

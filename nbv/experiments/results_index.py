@@ -141,6 +141,9 @@ INDEX = (
     Result("selection/round42/README.md", "selection/round42/bound/results.json", "its forty-second round, "
            "a diagnostic: lookahead-stereo's route on the true surface, at 13, 15 and 17 m of battery",
            "python scripts/route_bound.py (commands in the file)"),
+    Result("selection/round43/README.md", "selection/round43/screen_frontier1/results.json", "its forty-third "
+           "round: a gain counting surface, not unknown depth, screened on exact depth (not adopted)",
+           LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

@@ -141,8 +141,13 @@ INDEX = (
     Result("selection/round42/README.md", "selection/round42/bound/results.json", "its forty-second round, "
            "a diagnostic: lookahead-stereo's route on the true surface, at 13, 15 and 17 m of battery",
            "python scripts/route_bound.py (commands in the file)"),
-    Result("selection/round43/README.md", "selection/round43/screen_frontier1/results.json", "its forty-third "
-           "round: a gain counting surface, not unknown depth, screened on exact depth (not adopted)",
+    Result("selection/round43/README.md", "selection/round43/screen_frontier1/results.json",
+           "its forty-third round: a gain counting surface, not unknown depth, screened on exact depth (not "
+           "adopted)",
+           LOOKS_EVAL),
+    Result("selection/round44/README.md", "selection/round44/screen_sides2/results.json",
+           "its forty-fourth round: the worth of a side never measured, 2 and 0.5, screened on exact depth "
+           "(not adopted)",
            LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",

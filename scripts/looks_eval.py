@@ -246,15 +246,14 @@ def write_study(out: Path, args: argparse.Namespace, results: dict, checks: dict
         "results": results, "checks": checks, "command": sys.argv}))
 
 
-def conclude(args: argparse.Namespace, results: dict, names: list[str], title: str) -> str:
+def conclude(args: argparse.Namespace, results: dict, names: list[str], title: str) -> None:
     """A study's end: the checks of the planners `names`, the table against the tuned orbit, the output
-    folder (`write_study`, its chart titled `title`); the table, printed and returned."""
+    folder (`write_study`, its chart titled `title`); the table printed."""
     checks = policy_acceptance(results, args.scenes, names)
     table = report(results, args.scenes, args.seeds, args.views, "orbit", checks)
     with atomic_folder(args.out, overwrite=True, outputs=STUDY_OUTPUTS) as out:
         write_study(out, args, results, checks, table, title)
     print(table)
-    return table
 
 
 def study_arguments(parser: argparse.ArgumentParser) -> None:

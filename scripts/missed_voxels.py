@@ -22,12 +22,14 @@ import numpy as np
 
 from common.io import atomic_folder, markdown_table, write_json, write_text
 from common.provenance import git_commit
+from nbv.features.source import ViewSource
 from nbv.planning.infogain import target_grid
 from nbv.planning.lookahead import LOOKAHEAD_GRID, STEREO_STEEP
 from nbv.planning.world import PlanningWorld
 from nbv.recon.config import OccupancyConfig
 from nbv.recon.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, sight_bin
 from nbv.recon.visibility import scene_visibility
+from nbv.rl.config import EnvConfig
 from nbv.rl.presets import default_preset
 from nbv.rl.validate import evaluation_env_config
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
@@ -49,25 +51,25 @@ def voxel_states(grid: OccupancyGrid, samples: np.ndarray, normals: np.ndarray) 
     counts = {name: int(np.sum(state == s)) for name, s in STATES.items()}
     occupied = state == OCCUPIED
     toward = -normals[occupied] / np.linalg.norm(normals[occupied], axis=1, keepdims=True)
-    quadrant = sight_bin(toward, grid.steep_deg) // 4 if grid.steep_deg else sight_bin(toward) // 3
-    width = 4 if grid.steep_deg else 3
-    measured = grid.sides[voxels[occupied]].astype(np.int64)
-    bands = range(1, width) if grid.steep_deg else range(width)  # the steep band measures no side
-    bits = sum((measured >> (width * quadrant + b)) & 1 for b in bands)
-    return counts | {"occupied, its quadrant measured": int(np.sum(bits > 0))}
+    per_quadrant = grid.sight_bins // 4
+    quadrant = sight_bin(toward, grid.steep_deg) // per_quadrant
+    columns = grid.side_bins()  # the look-ahead's sides: the steep band measures none
+    measured = ((grid.sides[voxels[occupied], None].astype(np.int64) >> columns) & 1).astype(bool)
+    facing = columns // per_quadrant == quadrant[:, None]
+    return counts | {"occupied, its quadrant measured": int(np.sum((measured & facing).any(axis=1)))}
 
 
-def start_row(scene: str, flights: dict[str, dict], seed: int) -> dict:
-    """One start view: the planner's views fused on exact depth, the missed samples' voxel states."""
-    config = evaluation_env_config(default_preset().env, SceneSet(scene=(scene,)))
-    world = PlanningWorld(config, seed=seed)
+def start_row(config: EnvConfig, source: ViewSource, flights: dict[str, dict], seed: int) -> dict:
+    """One start view: the planner's views fused on exact depth (rendered by `source`, one for every start
+    on the building), the missed samples' voxel states."""
+    world = PlanningWorld(config, seed=seed, source=source)
     target, camera = world.target, world.camera
-    center = target.center()
-    grid = target_grid(target, OccupancyConfig(grid_resolution=LOOKAHEAD_GRID), STEREO_STEEP)
+    center, occupancy = target.center(), OccupancyConfig(grid_resolution=LOOKAHEAD_GRID)
+    grid = target_grid(target, occupancy, STEREO_STEEP)
     views = {role: [Viewpoint(*v) for v in runs[str(seed)]["viewpoints"]] for role, runs in flights.items()}
     for view in views["planner"]:
-        grid.integrate(world.source.render_depth(view), camera.K, viewpoint_to_c2w(view, center),
-                       OccupancyConfig().integrate_ray_stride)
+        grid.integrate(source.render_depth(view), camera.K, viewpoint_to_c2w(view, center),
+                       occupancy.integrate_ray_stride)
     truth = scene_visibility(target, camera, seed=seed)
     seen = {role: truth.seen_by([viewpoint_to_c2w(v, center) for v in flown])
             for role, flown in views.items()}
@@ -81,7 +83,9 @@ def main() -> None:
     flight_arguments(parser, "orbit2")
     args = parser.parse_args()
     flights = read_flights(args)
-    rows = [start_row(args.scene, flights, seed) for seed in args.seeds]
+    config = evaluation_env_config(default_preset().env, SceneSet(scene=(args.scene,)))
+    source = ViewSource(config.camera, config.render, config.bov.feature_config(), config.obs_size)
+    rows = [start_row(config, source, flights, seed) for seed in args.seeds]
     head = ["start", "missed", *STATES, "occupied, its quadrant measured"]
     text = markdown_table(head, [[r[k] for k in ("seed", "missed", *head[2:])] for r in rows])
     with atomic_folder(args.out, overwrite=True, outputs=("results.json", "results.md")) as out:

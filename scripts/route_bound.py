@@ -65,11 +65,14 @@ class RouteBound(Planner):
                 seen[key] = truth.seen(viewpoint_to_c2w(view, center))
             return seen[key]
 
+        def step(action: np.ndarray, here: Viewpoint) -> Viewpoint:
+            return action_to_viewpoint(action, here, steps)
+
         view, chosen, route = world.start, [world.start], None
         known = sees(view).copy()
         for left in range((views or 13) - 1, 0, -1):
-            search = RouteSearch(view, left, sees, known, None, lambda a, v: action_to_viewpoint(a, v, steps),
-                                 STEREO_FLIGHT, len(known), flown_m=shell_path(chosen[0], chosen[1:]).total_m,
+            search = RouteSearch(view, left, sees, known, None, step, STEREO_FLIGHT, len(known),
+                                 flown_m=shell_path(chosen[0], chosen[1:]).total_m,
                                  allowance_m=self.battery_m, excess=STEREO_HINGE[1])
             route = search.best(route[1:] if route else None)
             view = search.next(route[0], view)

@@ -96,6 +96,8 @@ def arguments() -> argparse.Namespace:
     parser.add_argument("--steep", type=float, default=0.0,
                         help="with --sides, rays looking down more steeply than this many degrees are a "
                              "direction of their own (0: none)")
+    parser.add_argument("--sectors", type=int, default=4, choices=(4, 8),
+                        help="with --sides, a side is measured from one of 4 quadrants or 8 sectors")
     parser.add_argument("--steep-blind", action="store_true",
                         help="with --steep, the steep band measures no side (neither marks nor gains one)")
     parser.add_argument("--ceiling", type=float, default=0.0,
@@ -120,6 +122,7 @@ def named(options: LookaheadOptions) -> str:
         + (f"_H{o.horizon}" if o.horizon != HORIZON else "") + ("_nf" if o.next_to_free else "") \
         + ("_fw" if o.forward else "") + (f"_sp{o.spacing_m:g}" if o.spacing_m else "") \
         + (f"_si{o.sight_deg:g}" if o.sight_deg else "") + (f"_sd{o.sides:g}" if o.sides else "") \
+        + (f"_sc{o.sectors}" if o.sectors != 4 else "") \
         + (f"_stp{o.steep_deg:g}" + "b" * (not o.steep_measures) if o.steep_deg else "") \
         + (f"_ce{o.ceiling_deg:g}" if o.ceiling_deg else "") + ("_pc" if o.pace else "") \
         + ("_rt" if o.route else "") + (f"_rs{o.restarts}" if o.restarts else "")
@@ -143,6 +146,7 @@ def main() -> None:
                                patience=args.patience, horizon=args.horizon, next_to_free=args.next_to_free,
                                forward=args.forward, spacing_m=args.spacing, sight_deg=args.sight,
                                sides=args.sides, battery_per_view_m=args.per_view, steep_deg=args.steep,
+                               sectors=args.sectors,
                                steep_measures=not args.steep_blind, ceiling_deg=args.ceiling, pace=args.pace,
                                route=args.route, restarts=args.restarts)
     paired = replace(options, partners=tuple(args.partners), agree=args.agree, votes=args.votes)

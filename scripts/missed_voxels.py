@@ -51,8 +51,8 @@ def voxel_states(grid: OccupancyGrid, samples: np.ndarray, normals: np.ndarray) 
     counts = {name: int(np.sum(state == s)) for name, s in STATES.items()}
     occupied = state == OCCUPIED
     toward = -normals[occupied] / np.linalg.norm(normals[occupied], axis=1, keepdims=True)
-    per_quadrant = grid.sight_bins // 4
-    quadrant = sight_bin(toward, grid.steep_deg) // per_quadrant
+    per_quadrant = grid.sight_bins // grid.sectors
+    quadrant = sight_bin(toward, grid.steep_deg, grid.sectors) // per_quadrant
     columns = grid.side_bins()  # the look-ahead's sides: the steep band measures none
     measured = ((grid.sides[voxels[occupied], None].astype(np.int64) >> columns) & 1).astype(bool)
     facing = columns // per_quadrant == quadrant[:, None]

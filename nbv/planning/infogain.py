@@ -40,16 +40,17 @@ if TYPE_CHECKING:
     from nbv.planning.world import PlanningWorld
 
 
-def target_grid(scene: Scene, config: OccupancyConfig, steep_deg: float = 0.0) -> OccupancyGrid:
+def target_grid(scene: Scene, config: OccupancyConfig, steep_deg: float = 0.0,
+                sectors: int = 4) -> OccupancyGrid:
     """An all-unknown grid over the scene's target bounds, padded by the margin on the sides and the top
-    (`steep_deg`: the grid's steep band of sight directions, which only the look-ahead's sides use)."""
+    (`steep_deg` and `sectors`: the grid's sight directions, which only the look-ahead's sides use)."""
     if not scene.parts:
         raise ValueError(f"scene {scene.name!r} is a Mitsuba XML file: the infogain planner needs the "
                          "target's bounds, which it does not give")
     lower, upper = scene.bounds()
     margin = config.grid_margin_m
     return OccupancyGrid(lower - [margin, margin, 0.0], upper + margin, config.grid_resolution, config.votes,
-                         steep_deg)
+                         steep_deg, sectors)
 
 
 class InfoGainPlanner(Planner):

@@ -194,6 +194,9 @@ class LookaheadOptions:
     """> 0, with `sides`: rays looking down more steeply than this many degrees are a direction of their own
     (`OccupancyGrid`'s `steep_deg`, set here alone: only the sides use it; round 35): a wall seen only from
     nearly overhead, at a grazing angle, still gains a view that meets it from the side."""
+    sectors: int = 4
+    """With `sides`, the horizontal directions a side is measured from: 4 quadrants or 8 sectors
+    (`OccupancyGrid`'s `sectors`; round 45)."""
     steep_measures: bool = True
     """With `steep_deg`, whether the steep band is a direction like the others (round 35) or measures no
     side (round 36): a steep ray then neither marks the side it meets as measured nor gains a view anything
@@ -220,10 +223,10 @@ class LookaheadOptions:
             raise ValueError(f"lookahead's flight allowance, excess weight and battery a view are finite and "
                              f">= 0, got {self.allowance_m}, {self.excess}, {self.battery_per_view_m}")
         if not 0 <= self.sides < float("inf") or not 0 <= self.steep_deg < 90 \
-                or not 0 <= self.ceiling_deg <= 90:
+                or not 0 <= self.ceiling_deg <= 90 or self.sectors not in (4, 8):
             raise ValueError(f"lookahead's weight of a side never measured is finite and >= 0, its steep "
-                             f"band under 90 degrees and its ceiling at most 90 (0: none), got {self.sides}, "
-                             f"{self.steep_deg}, {self.ceiling_deg}")
+                             f"band under 90 degrees, its ceiling at most 90 (0: none), its sectors 4 or "
+                             f"8, got {self.sides}, {self.steep_deg}, {self.ceiling_deg}, {self.sectors}")
         if not 0 <= self.spacing_m < float("inf") or not 0 <= self.sight_deg < 180:
             raise ValueError(f"lookahead's spacing is a finite distance >= 0 and its sight rule 0 to 180 "
                              f"degrees (0: none), got {self.spacing_m}, {self.sight_deg}")
@@ -282,7 +285,8 @@ class LookaheadPlanner(Planner):
         camera, center, options = world.camera, world.target.center(), self.options
         stride = max(1, round(camera.width / self.rays))
         grid = target_grid(world.target, OccupancyConfig(grid_resolution=self.grid, gain_ray_stride=stride,
-                                                         votes=options.votes), options.steep_deg)
+                                                         votes=options.votes), options.steep_deg,
+                           options.sectors)
         steps = replace(world.env, action_mode="forward", relative_step=FORWARD_STEP) if options.forward \
             else replace(world.env, action_mode="orbit", relative_step=ORBIT_STEP)
 
@@ -373,7 +377,7 @@ def side_items(grid: OccupancyGrid, occupied: np.ndarray, known: np.ndarray, sid
     (`OccupancyGrid.sides`); and their worth (1 a voxel, `sides` a direction). Without, `known` and None."""
     if not sides:
         return known, None
-    measured = (grid.sides[occupied, None] >> columns.astype(np.uint16)) & 1
+    measured = (grid.sides[occupied, None] >> columns.astype(np.uint32)) & 1
     weights = np.concatenate([np.ones(len(known)), np.full(measured.size, sides)])
     return np.concatenate([known, measured.astype(bool).reshape(-1)]), weights
 

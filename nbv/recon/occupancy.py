@@ -39,7 +39,9 @@ probabilistic:
   With `steep_deg`, rays looking down more steeply than that take bins of their
   own (16 in all): a wall seen only from nearly overhead is seen at a grazing
   angle, where a photograph resolves little of it, and still counts as unmeasured
-  from the side (round 35).
+  from the side (round 35). With `sectors` = 8, the horizontal directions are
+  eight 45-degree sectors instead of four quadrants (24 or 32 bins): a face seen
+  40 degrees off its normal stays unmeasured straight on (round 45).
 
 Depth is z-depth (docs/conventions.md, `render.renderer`): a pixel's ray has
 direction (x, y, 1) in the camera frame (`render.camera.pixel_rays`), so its hit
@@ -75,19 +77,27 @@ CHUNK_SAMPLES = 1 << 21
 """Ray samples held at once (a few arrays of 2M numbers)."""
 
 
-def sight_bin(directions: np.ndarray, steep_deg: float = 0.0) -> np.ndarray:
+def sight_bin(directions: np.ndarray, steep_deg: float = 0.0, sectors: int = 4) -> np.ndarray:
     """The bin (0 to `SIGHT_BINS` - 1) of each unit ray direction (..., 3): its horizontal quadrant (by the
     larger of |x| and |y| and its sign) times 3, plus 0 looking down, 1 level, 2 looking up. With
     `steep_deg` > 0, the quadrant times 4, plus 0 looking down more steeply than that, then 1, 2, 3 as above
-    (16 bins).
+    (16 bins). With `sectors` = 8, the quadrant is one of eight 45-degree sectors, the first centred on +x,
+    counter-clockwise.
 
     >>> sight_bin(np.array([[1.0, 0, 0], [0, -0.9, 0.44], [-0.6, 0.5, -0.62]])).tolist()
     [4, 2, 6]
     >>> sight_bin(np.array([[1.0, 0, 0], [0.5, 0, -0.87], [0.87, 0, -0.5]]), steep_deg=45).tolist()
     [6, 4, 5]
+    >>> sight_bin(np.array([[1.0, 0, 0], [0.6, 0.6, 0.53], [0.6, -0.8, 0]]), sectors=8).tolist()
+    [1, 5, 22]
     """
+    if sectors not in (4, 8):
+        raise ValueError(f"sight bins split the horizon into 4 or 8 sectors, got {sectors}")
     x, y, z = directions[..., 0], directions[..., 1], directions[..., 2]
-    quadrant = np.where(np.abs(x) >= np.abs(y), np.where(x >= 0, 1, 2), np.where(y >= 0, 3, 0))
+    if sectors == 4:
+        quadrant = np.where(np.abs(x) >= np.abs(y), np.where(x >= 0, 1, 2), np.where(y >= 0, 3, 0))
+    else:
+        quadrant = np.round(np.arctan2(y, x) / (np.pi / 4)).astype(np.int64) % 8
     band = (z > -LEVEL_SIN).astype(np.int64) + (z > LEVEL_SIN)
     if not steep_deg:
         return 3 * quadrant + band
@@ -104,10 +114,11 @@ class OccupancyGrid:
         votes: weigh hits and passes, one vote an image (module docstring), instead of occupied winning.
         steep_deg: > 0, rays looking down more steeply than this many degrees are a direction of their own
             (`sight_bin`, `sight_bins` 16).
+        sectors: the horizontal directions of `sight_bin`, 4 quadrants or 8 sectors.
     """
 
     def __init__(self, lower: np.ndarray, upper: np.ndarray, resolution: int, votes: bool = False,
-                 steep_deg: float = 0.0) -> None:
+                 steep_deg: float = 0.0, sectors: int = 4) -> None:
         self.lower = np.asarray(lower, dtype=np.float64)
         extent = np.asarray(upper, dtype=np.float64) - self.lower
         if extent.shape != (3,) or not np.all(np.isfinite(extent)) or np.any(extent <= 0):
@@ -121,17 +132,20 @@ class OccupancyGrid:
         if not 0 <= steep_deg < 90 or 0 < steep_deg <= np.degrees(np.arcsin(LEVEL_SIN)):
             raise ValueError(f"occupancy grid's steep band starts past the level band's 10 degrees and under "
                              f"90 (0: none), got {steep_deg}")
-        self.votes, self.steep_deg = votes, steep_deg
-        self.sides = np.zeros(self.state.size, np.uint16)  # bit b: measured from `sight_bin` b
+        if sectors not in (4, 8):
+            raise ValueError(f"occupancy grid's sight bins split the horizon in 4 or 8, got {sectors}")
+        self.votes, self.steep_deg, self.sectors = votes, steep_deg, sectors
+        self.sides = np.zeros(self.state.size, np.uint32)  # bit b: measured from `sight_bin` b
         self.hits, self.passes = (np.zeros(self.state.size if votes else 0, np.uint32) for _ in range(2))
 
     @property
     def sight_bins(self) -> int:
-        """How many directions `sight_bin` tells apart here: 12, or 16 with a steep band."""
-        return SIGHT_BINS + 4 if self.steep_deg else SIGHT_BINS
+        """How many directions `sight_bin` tells apart here: 12, or 16 with a steep band (twice that with 8
+        sectors)."""
+        return self.sectors * (4 if self.steep_deg else 3)
 
     def side_bins(self) -> np.ndarray:
-        """The sight bins but the steep band's (each quadrant's first of four, `sight_bin`); all, without."""
+        """The sight bins but the steep band's (each sector's first of four, `sight_bin`); all, without."""
         every = np.arange(self.sight_bins)
         return every[every % 4 != 0] if self.steep_deg else every
 
@@ -162,8 +176,9 @@ class OccupancyGrid:
         voxels, toward = self.voxel_index(hits[inside]), rays[depth > 0][inside]
         hit = np.zeros(flat.size, dtype=bool)
         hit[voxels] = True
-        bins = sight_bin(toward / np.linalg.norm(toward, axis=-1, keepdims=True), self.steep_deg)
-        np.bitwise_or.at(self.sides, voxels, (1 << bins).astype(np.uint16))
+        toward /= np.linalg.norm(toward, axis=-1, keepdims=True)
+        bins = sight_bin(toward, self.steep_deg, self.sectors)
+        np.bitwise_or.at(self.sides, voxels, (1 << bins).astype(np.uint32))
         if not self.votes:
             flat[crossed & (flat != OCCUPIED)] = FREE
             flat[hit] = OCCUPIED
@@ -203,7 +218,7 @@ class OccupancyGrid:
         flat = self.state.reshape(-1)
         reached = np.zeros(flat.size, dtype=bool)
         sighted = np.zeros((flat.size, self.sight_bins), dtype=bool) if sides else None
-        bins, done = sight_bin(rays, self.steep_deg) if sides else None, 0
+        bins, done = sight_bin(rays, self.steep_deg, self.sectors) if sides else None, 0
         for index, valid in self._walk(origin, rays, np.full(len(rays), np.inf)):
             state = flat[index]
             occupied = valid & (state == OCCUPIED)

@@ -160,8 +160,18 @@ def test_valuing_unmeasured_sides_changes_a_looking_flight_but_not_a_blind_one()
     blind = tiny(0.0, "stereo", True, forward=True).plan(world, 3)
     assert tiny(0.0, "stereo", True, forward=True, sides=50.0).plan(world, 3) == blind  # nothing measured
     with pytest.raises(ValueError, match="weight of a side never measured is finite and >= 0, its steep band "
-                                         "under 90 degrees and its ceiling at most 90 .0: none., got -1"):
+                                         "under 90 degrees, its ceiling at most 90 .0: none., its sectors 4 "
+                                         "or 8, got -1"):
         LookaheadOptions(sides=-1)
+
+
+def test_eight_sectors_change_a_flight_that_values_sides_and_only_that():
+    world = PlanningWorld(config(), seed=3)
+    plain, sides = tiny(0.0, forward=True).plan(world, 4), tiny(0.0, forward=True, sides=50.0).plan(world, 4)
+    assert tiny(0.0, forward=True, sectors=8).plan(world, 4) == plain  # no sides valued: no change
+    assert tiny(0.0, forward=True, sides=50.0, sectors=8).plan(world, 4) != sides
+    with pytest.raises(ValueError, match="its sectors 4 or 8, got 0.0, 0.0, 0.0, 6"):
+        LookaheadOptions(sectors=6)
 
 
 def test_a_steep_band_changes_a_flight_that_values_sides_and_only_that():
@@ -169,8 +179,8 @@ def test_a_steep_band_changes_a_flight_that_values_sides_and_only_that():
     plain, sides = tiny(0.0, forward=True).plan(world, 4), tiny(0.0, forward=True, sides=50.0).plan(world, 4)
     assert tiny(0.0, forward=True, steep_deg=60.0).plan(world, 4) == plain  # no sides valued: no change
     assert tiny(0.0, forward=True, sides=50.0, steep_deg=60.0).plan(world, 4) != sides
-    with pytest.raises(ValueError, match="steep band under 90 degrees and its ceiling at most 90 .0: none., "
-                                         "got 0.0, 90"):
+    with pytest.raises(ValueError, match="steep band under 90 degrees, its ceiling at most 90 .0: none., its "
+                                         "sectors 4 or 8, got 0.0, 90"):
         LookaheadOptions(steep_deg=90)
 
 
@@ -351,5 +361,5 @@ def test_a_ceiling_holds_every_step_at_or_under_it_and_changes_a_climbing_flight
     assert max(v.elevation for v in free[1:]) > np.radians(30)  # the free flight climbs past it
     held = tiny(0.0, forward=True, sides=50.0, ceiling_deg=30.0).plan(world, 6)
     assert held != free and max(v.elevation for v in held[1:]) <= np.radians(30) + 1e-12
-    with pytest.raises(ValueError, match="ceiling at most 90 .0: none., got 0.0, 0.0, 91"):
+    with pytest.raises(ValueError, match="at most 90 .0: none., its sectors 4 or 8, got 0.0, 0.0, 91, 4"):
         LookaheadOptions(ceiling_deg=91)

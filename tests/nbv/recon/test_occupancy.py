@@ -115,6 +115,34 @@ def test_a_steep_band_gives_rays_looking_down_past_it_bins_of_their_own():
         OccupancyGrid(np.zeros(3), np.ones(3), resolution=2, steep_deg=10)
 
 
+def test_eight_sectors_split_the_horizon_at_22_5_degrees_either_side_of_each_compass_point():
+    def level(degrees: float) -> list[float]:
+        return [np.cos(np.radians(degrees)), np.sin(np.radians(degrees)), 0.0]
+
+    rays = np.array([level(d) for d in (0, 22, 23, 45, 90, 180, -44, -68)])
+    assert (sight_bin(rays, sectors=8) // 3).tolist() == [0, 0, 1, 1, 2, 4, 7, 6]  # counter-clockwise from +x
+    assert (sight_bin(rays) // 3).tolist() == [1, 1, 1, 1, 3, 2, 1, 0]  # the quadrants, for comparison
+    assert sight_bin(rays[:1] * [np.cos(0.2), 1, 1] + [0, 0, -np.sin(1.2)], 60, 8).tolist() == [0]  # steep
+    grid = OccupancyGrid(np.zeros(3), np.ones(3), resolution=2, steep_deg=60, sectors=8)
+    assert grid.sight_bins == 32 and grid.side_bins().tolist() == [b for b in range(32) if b % 4]
+    with pytest.raises(ValueError, match="sight bins split the horizon in 4 or 8, got 6"):
+        OccupancyGrid(np.zeros(3), np.ones(3), resolution=2, sectors=6)
+    with pytest.raises(ValueError, match="split the horizon into 4 or 8 sectors, got 3"):
+        sight_bin(rays, sectors=3)
+
+
+def test_eight_sectors_record_a_hit_past_the_first_16_bits():
+    forward = np.array([np.sqrt(0.5), -np.sqrt(0.5), 0.0])  # level, 45 degrees clockwise of +x: sector 7
+    down = np.array([0, 0, -1.0])
+    c2w = np.eye(4)
+    c2w[:3, :3] = np.column_stack([np.cross(down, forward), down, forward])  # OpenCV: x right, y down
+    c2w[:3, 3] = np.full(3, 0.5) - 2 * forward  # 2 m short of the one voxel's centre
+    grid = OccupancyGrid(np.zeros(3), np.ones(3), resolution=1, steep_deg=60, sectors=8)
+    grid.integrate(np.array([[2.0]], np.float32), ONE_PIXEL, c2w)
+    assert grid.sides.tolist() == [1 << (7 * 4 + 2)]  # sector 7, level (bin 30 of 32)
+    assert np.argwhere(grid.sighted(ONE_PIXEL, c2w, 1, 1)).tolist() == [[0, 30]]
+
+
 def test_a_grid_with_a_steep_band_records_a_hit_from_overhead_in_it():
     down = np.array([[1, 0, 0, 0.5], [0, -1, 0, 0.5], [0, 0, -1, 5.0], [0, 0, 0, 1]])  # at z = 5, looks -z
     column = [OccupancyGrid(np.zeros(3), np.array([1.0, 1.0, 4.0]), resolution=4, steep_deg=steep)

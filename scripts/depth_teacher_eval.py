@@ -25,7 +25,7 @@ round 36: `--steep-blind` makes that band measure no side instead (_stpDb); `--c
 or under C degrees of elevation (_ceC). Round 38: `--pace` charges the hinge on each leg's metres past an
 even share of the battery (_pc). Round 39: `--route` plans every view still to take together as one
 route, re-planned at each view (_rt). Round 40: `--restarts N` also improves N routes of random steps
-(_rsN).
+(_rsN). Round 45: `--sectors 8` measures sides from eight 45-degree horizontal sectors, not quadrants (_sc8).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """

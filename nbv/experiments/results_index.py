@@ -149,9 +149,9 @@ INDEX = (
            "its forty-fourth round: the worth of a side never measured, 2 and 0.5, screened on exact depth "
            "(not adopted)",
            LOOKS_EVAL),
-    Result("selection/round45/README.md", "selection/round45/screen_sectors8_sides1/results.json",
-           "its forty-fifth round: sides from eight horizontal sectors, screened on exact depth, then "
-           "flown on stereo", LOOKS_EVAL),
+    Result("selection/round45/README.md", "selection/round45/stereo_starts0-5/results.json",
+           "its forty-fifth round: sides from eight horizontal sectors, passed the screen on exact depth, "
+           "lost a courtyard on stereo (not adopted, stopped early)", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

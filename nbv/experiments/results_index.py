@@ -152,6 +152,9 @@ INDEX = (
     Result("selection/round45/README.md", "selection/round45/stereo_starts0-5/results.json",
            "its forty-fifth round: sides from eight horizontal sectors, passed the screen on exact depth, "
            "lost a courtyard on stereo (not adopted, stopped early)", LOOKS_EVAL),
+    Result("selection/round46/README.md", "selection/round46/reference/results.json",
+           "its forty-sixth round, a diagnostic: lookahead-stereo and eight sectors on four training "
+           "courtyards no round chose on", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

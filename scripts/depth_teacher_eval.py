@@ -46,6 +46,7 @@ from nbv.planning.lookahead import (
     LookaheadPlanner,
 )
 from nbv.planning.registry import make_planner
+from nbv.recon.occupancy import SECTORS
 from nbv.rl.presets import default_preset
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -96,7 +97,7 @@ def arguments() -> argparse.Namespace:
     parser.add_argument("--steep", type=float, default=0.0,
                         help="with --sides, rays looking down more steeply than this many degrees are a "
                              "direction of their own (0: none)")
-    parser.add_argument("--sectors", type=int, default=4, choices=(4, 8),
+    parser.add_argument("--sectors", type=int, default=4, choices=SECTORS,
                         help="with --sides, a side is measured from one of 4 quadrants or 8 sectors")
     parser.add_argument("--steep-blind", action="store_true",
                         help="with --steep, the steep band measures no side (neither marks nor gains one)")

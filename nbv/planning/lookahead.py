@@ -78,7 +78,7 @@ from nbv.planning.infogain import target_grid
 from nbv.planning.route import RouteSearch, view_key
 from nbv.planning.step_rules import ruled_out
 from nbv.recon.config import OccupancyConfig
-from nbv.recon.occupancy import OCCUPIED, UNKNOWN, OccupancyGrid
+from nbv.recon.occupancy import OCCUPIED, SECTORS, UNKNOWN, OccupancyGrid
 from nbv.recon.stereo import StereoConfig, agreed_depth, box_stereo_depth, grayscale
 from nbv.rl.env import action_to_viewpoint
 from nbv.rl.expert import CANDIDATES, best_action, expert_scores
@@ -223,7 +223,7 @@ class LookaheadOptions:
             raise ValueError(f"lookahead's flight allowance, excess weight and battery a view are finite and "
                              f">= 0, got {self.allowance_m}, {self.excess}, {self.battery_per_view_m}")
         if not 0 <= self.sides < float("inf") or not 0 <= self.steep_deg < 90 \
-                or not 0 <= self.ceiling_deg <= 90 or self.sectors not in (4, 8):
+                or not 0 <= self.ceiling_deg <= 90 or self.sectors not in SECTORS:
             raise ValueError(f"lookahead's weight of a side never measured is finite and >= 0, its steep "
                              f"band under 90 degrees, its ceiling at most 90 (0: none), its sectors 4 or "
                              f"8, got {self.sides}, {self.steep_deg}, {self.ceiling_deg}, {self.sectors}")
@@ -284,9 +284,8 @@ class LookaheadPlanner(Planner):
         """The start view, then each next one the orbit step whose look-ahead on the grid scores best."""
         camera, center, options = world.camera, world.target.center(), self.options
         stride = max(1, round(camera.width / self.rays))
-        grid = target_grid(world.target, OccupancyConfig(grid_resolution=self.grid, gain_ray_stride=stride,
-                                                         votes=options.votes), options.steep_deg,
-                           options.sectors)
+        occupancy = OccupancyConfig(grid_resolution=self.grid, gain_ray_stride=stride, votes=options.votes)
+        grid = target_grid(world.target, occupancy, options.steep_deg, options.sectors)
         steps = replace(world.env, action_mode="forward", relative_step=FORWARD_STEP) if options.forward \
             else replace(world.env, action_mode="orbit", relative_step=ORBIT_STEP)
 

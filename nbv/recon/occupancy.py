@@ -73,6 +73,8 @@ UNKNOWN, FREE, OCCUPIED = 0, 1, 2
 SIGHT_BINS, LEVEL_SIN = 12, np.sin(np.radians(10.0))
 """Directions a voxel is measured from: 4 horizontal quadrants, each looking up, level or down (a ray's
 vertical part beyond `LEVEL_SIN` of its length, 10 degrees); with a steep band (`sight_bin`), 16."""
+SECTORS = (4, 8)
+"""How `sight_bin` may split the horizon: 4 quadrants or 8 sectors of 45 degrees."""
 CHUNK_SAMPLES = 1 << 21
 """Ray samples held at once (a few arrays of 2M numbers)."""
 
@@ -91,7 +93,7 @@ def sight_bin(directions: np.ndarray, steep_deg: float = 0.0, sectors: int = 4) 
     >>> sight_bin(np.array([[1.0, 0, 0], [0.6, 0.6, 0.53], [0.6, -0.8, 0]]), sectors=8).tolist()
     [1, 5, 22]
     """
-    if sectors not in (4, 8):
+    if sectors not in SECTORS:
         raise ValueError(f"sight bins split the horizon into 4 or 8 sectors, got {sectors}")
     x, y, z = directions[..., 0], directions[..., 1], directions[..., 2]
     if sectors == 4:
@@ -132,7 +134,7 @@ class OccupancyGrid:
         if not 0 <= steep_deg < 90 or 0 < steep_deg <= np.degrees(np.arcsin(LEVEL_SIN)):
             raise ValueError(f"occupancy grid's steep band starts past the level band's 10 degrees and under "
                              f"90 (0: none), got {steep_deg}")
-        if sectors not in (4, 8):
+        if sectors not in SECTORS:
             raise ValueError(f"occupancy grid's sight bins split the horizon in 4 or 8, got {sectors}")
         self.votes, self.steep_deg, self.sectors = votes, steep_deg, sectors
         self.sides = np.zeros(self.state.size, np.uint32)  # bit b: measured from `sight_bin` b

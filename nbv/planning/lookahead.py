@@ -376,7 +376,7 @@ def side_items(grid: OccupancyGrid, occupied: np.ndarray, known: np.ndarray, sid
     (`OccupancyGrid.sides`); and their worth (1 a voxel, `sides` a direction). Without, `known` and None."""
     if not sides:
         return known, None
-    measured = (grid.sides[occupied, None] >> columns.astype(np.uint32)) & 1
+    measured = (grid.sides[occupied, None] >> columns.astype(grid.sides.dtype)) & 1
     weights = np.concatenate([np.ones(len(known)), np.full(measured.size, sides)])
     return np.concatenate([known, measured.astype(bool).reshape(-1)]), weights
 

@@ -122,7 +122,8 @@ def test_eight_sectors_split_the_horizon_at_22_5_degrees_either_side_of_each_com
     rays = np.array([level(d) for d in (0, 22, 23, 45, 90, 180, -44, -68)])
     assert (sight_bin(rays, sectors=8) // 3).tolist() == [0, 0, 1, 1, 2, 4, 7, 6]  # counter-clockwise from +x
     assert (sight_bin(rays) // 3).tolist() == [1, 1, 1, 1, 3, 2, 1, 0]  # the quadrants, for comparison
-    assert sight_bin(rays[:1] * [np.cos(0.2), 1, 1] + [0, 0, -np.sin(1.2)], 60, 8).tolist() == [0]  # steep
+    steep = np.array([[np.cos(np.radians(61)), 0, -np.sin(np.radians(61))]])  # +x, 61 degrees down
+    assert sight_bin(steep, 60, 8).tolist() == [0]  # sector 0, the steep band
     grid = OccupancyGrid(np.zeros(3), np.ones(3), resolution=2, steep_deg=60, sectors=8)
     assert grid.sight_bins == 32 and grid.side_bins().tolist() == [b for b in range(32) if b % 4]
     with pytest.raises(ValueError, match="sight bins split the horizon in 4 or 8, got 6"):

@@ -26,6 +26,7 @@ or under C degrees of elevation (_ceC). Round 38: `--pace` charges the hinge on 
 even share of the battery (_pc). Round 39: `--route` plans every view still to take together as one
 route, re-planned at each view (_rt). Round 40: `--restarts N` also improves N routes of random steps
 (_rsN). Round 45: `--sectors 8` measures sides from eight 45-degree horizontal sectors, not quadrants (_sc8).
+Round 48: `--bands 2` tells sides by two vertical bands, down and level one (_bd2).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -39,6 +40,7 @@ from pathlib import Path
 
 from nbv.planning.config import PlanSettings
 from nbv.planning.lookahead import (
+    BANDS,
     HORIZON,
     PARTNER_SIDES,
     STEREO_PARTNERS,
@@ -99,6 +101,8 @@ def arguments() -> argparse.Namespace:
                              "direction of their own (0: none)")
     parser.add_argument("--sectors", type=int, default=4, choices=SECTORS,
                         help="with --sides, a side is measured from one of 4 quadrants or 8 sectors")
+    parser.add_argument("--bands", type=int, default=3, choices=BANDS,
+                        help="with --sides, a side is told by 3 vertical bands or 2 (down and level one)")
     parser.add_argument("--steep-blind", action="store_true",
                         help="with --steep, the steep band measures no side (neither marks nor gains one)")
     parser.add_argument("--ceiling", type=float, default=0.0,
@@ -123,7 +127,7 @@ def named(options: LookaheadOptions) -> str:
         + (f"_H{o.horizon}" if o.horizon != HORIZON else "") + ("_nf" if o.next_to_free else "") \
         + ("_fw" if o.forward else "") + (f"_sp{o.spacing_m:g}" if o.spacing_m else "") \
         + (f"_si{o.sight_deg:g}" if o.sight_deg else "") + (f"_sd{o.sides:g}" if o.sides else "") \
-        + (f"_sc{o.sectors}" if o.sectors != 4 else "") \
+        + (f"_sc{o.sectors}" if o.sectors != 4 else "") + (f"_bd{o.bands}" if o.bands != 3 else "") \
         + (f"_stp{o.steep_deg:g}" + "b" * (not o.steep_measures) if o.steep_deg else "") \
         + (f"_ce{o.ceiling_deg:g}" if o.ceiling_deg else "") + ("_pc" if o.pace else "") \
         + ("_rt" if o.route else "") + (f"_rs{o.restarts}" if o.restarts else "")
@@ -147,7 +151,7 @@ def main() -> None:
                                patience=args.patience, horizon=args.horizon, next_to_free=args.next_to_free,
                                forward=args.forward, spacing_m=args.spacing, sight_deg=args.sight,
                                sides=args.sides, battery_per_view_m=args.per_view, steep_deg=args.steep,
-                               sectors=args.sectors,
+                               sectors=args.sectors, bands=args.bands,
                                steep_measures=not args.steep_blind, ceiling_deg=args.ceiling, pace=args.pace,
                                route=args.route, restarts=args.restarts)
     paired = replace(options, partners=tuple(args.partners), agree=args.agree, votes=args.votes)

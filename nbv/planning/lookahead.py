@@ -26,43 +26,35 @@ plane-sweep stereo between the two (`nbv.recon.stereo`) gives both frames' depth
 match; only that depth is fused, the rest stays unknown. It reads images and the poses flown (and the target's
 box), so it is held to every check of the policies, the blank-images one included. Held out, scored once on
 the teacher's steps (paper_results/online/stereo in git at e7f44fa): 3.8 points above the ring in 1.26x its
-metres, 31.3 lost with blank frames, 3.4 under the ring on the walled compound. Round 26
-(paper_results/selection/round26) tried more second frames (`partners`), fusing only depths pairs agree on
-(`agree`) and a grid that votes hits against passes (`votes`) on the validation buildings: each passes the
-same four checks, so none is the default. Round 27 (paper_results/selection/round27) tried counting only each
-ray's first unknown voxels (`frontier`), a battery's hinge on the flight (`allowance_m`, `excess`), giving up
-on what views flown looked at without measuring (`patience`), five views ahead (`horizon`) and counting only
-the unknown beside free space (`next_to_free`): none passes more, so none is the default either. Round 28
-(paper_results/selection/round28) flew it on the forward steps of a pilot's orbit (`forward`): five of six
-checks on the validation buildings, so they are `lookahead-stereo`'s steps (`STEREO_FORWARD`). Held out,
-scored once (paper_results/online/stereo): 3.9 points above the ring in 1.29x its metres, 4.3 lost with blank
-frames, 1.7 under the ring on the walled compound, where it ends its flights near-hovering at 80 degrees (a
-forward step there is an arc of 0.13 m). Round 29 (paper_results/selection/round29) never stepped within 0.25
-or 0.5 m of a camera flown (`spacing_m`): more coverage, past the metres bar, so not the default. Round 30
-(paper_results/selection/round30) never looked along a sight line within 15 or 10 degrees of one flown
-(`sight_deg`), alone and under the teacher's hinge: past the metres bar, or the courtyard further under the
-ring than round 28's, so not the default either. Round 31 (paper_results/selection/round31) found what the
-grid cannot see: an occupied voxel holds every face of the surface in it, so the underside of a tower's top,
-seen only from the low ring, counts as known once seen from above. With `sides` a view also gains for each
-occupied voxel it would meet from a direction never measured (`OccupancyGrid.sighted`); under a battery's
-hinge (2 a metre past 13 m) that passed five of six checks with the worst building 0.4 under the ring
-(round 28's 0.6) in 1.44x its metres, so it is `lookahead-stereo`'s setting (`STEREO_SIDES`, `STEREO_HINGE`).
-The hinge's 13 m stopped it at 13 m at any view budget (`make tables`' budget part); round 33
-(paper_results/selection/round33) let the battery follow the budget, one metre a view past 13 views
-(`battery_per_view_m`, `STEREO_PER_VIEW`): more coverage at 16 views, so it is the default. Round 35
-(paper_results/selection/round35) gave rays looking down more steeply than 60 degrees sight bins of their own
-(`steep_deg`): that drew views to nearly overhead, so not the default. Round 36 made that band measure no side
-(`steep_measures` off: a wall seen only from overhead, at a grazing angle, stays unmeasured, and a view gains
-nothing for the sides it meets steeply) or held every step under 45 degrees (`ceiling_deg`): more coverage
-but not the courtyard gain its rule asked; round 37 confirmed the blind band from start views never flown
-(paper_results/selection/round37), so it is `lookahead-stereo`'s (`STEREO_STEEP`). Held out, scored once
-(paper_results/online/stereo, at 05e7f11): 4.4 points above the ring in 1.46x its metres, 3.9 above random
-views on the courtyard (the bar is 5), five of six checks as round 31's setting. Round 38
-(paper_results/selection/round38) spent the battery at an even pace (`pace`): both courtyards lower, so off.
-Round 39 (paper_results/selection/round39) chose every view still to take together, as one route re-planned
-at each view (`route`, `nbv.planning.route`): 0.9 points more coverage over nine start views, the worst
-building 1.0 above the ring, both courtyards up, five of six checks on both start sets, so it is
-`lookahead-stereo`'s (`STEREO_ROUTE`).
+metres, 31.3 lost with blank frames, 3.4 under the ring on the walled compound. Rounds 26, 27, 29 and 30
+(paper_results/selection, docs/rl.md) tried the options below on the validation buildings, none passing more
+checks (`partners`, `agree`, `votes`, `frontier`, `patience`, `horizon`, `next_to_free`, `spacing_m`,
+`sight_deg`), so none is a default. Round 28 (paper_results/selection/round28) flew it on the forward steps of
+a pilot's orbit (`forward`): five of six checks on the validation buildings, so they are `lookahead-stereo`'s
+steps (`STEREO_FORWARD`). Held out, scored once (paper_results/online/stereo): 3.9 points above the ring in
+1.29x its metres, 4.3 lost with blank frames, 1.7 under the ring on the walled compound, where it ends its
+flights near-hovering at 80 degrees (a forward step there is an arc of 0.13 m). Round 31
+(paper_results/selection/round31) found what the grid cannot see: an occupied voxel holds every face of the
+surface in it, so the underside of a tower's top, seen only from the low ring, counts as known once seen from
+above. With `sides` a view also gains for each occupied voxel it would meet from a direction never measured
+(`OccupancyGrid.sighted`); under a battery's hinge (2 a metre past 13 m) that passed five of six checks with
+the worst building 0.4 under the ring (round 28's 0.6) in 1.44x its metres, so it is `lookahead-stereo`'s
+setting (`STEREO_SIDES`, `STEREO_HINGE`). The hinge's 13 m stopped it at 13 m at any view budget (`make
+tables`' budget part); round 33 (paper_results/selection/round33) let the battery follow the budget, one metre
+a view past 13 views (`battery_per_view_m`, `STEREO_PER_VIEW`): more coverage at 16 views, so it is the
+default. Round 35 (paper_results/selection/round35) gave rays looking down more steeply than 60 degrees sight
+bins of their own (`steep_deg`): that drew views to nearly overhead, so not the default. Round 36 made that
+band measure no side (`steep_measures` off: a wall seen only from overhead, at a grazing angle, stays
+unmeasured, and a view gains nothing for the sides it meets steeply) or held every step under 45 degrees
+(`ceiling_deg`): more coverage but not the courtyard gain its rule asked; round 37 confirmed the blind band
+from start views never flown (paper_results/selection/round37), so it is `lookahead-stereo`'s
+(`STEREO_STEEP`). Held out, scored once (paper_results/online/stereo, at 05e7f11): 4.4 points above the ring
+in 1.46x its metres, 3.9 above random views on the courtyard (the bar is 5), five of six checks as round 31's
+setting. Round 38 (paper_results/selection/round38) spent the battery at an even pace (`pace`): both
+courtyards lower, so off. Round 39 (paper_results/selection/round39) chose every view still to take together,
+as one route re-planned at each view (`route`, `nbv.planning.route`): 0.9 points more coverage over nine start
+views, the worst building 1.0 above the ring, both courtyards up, five of six checks on both start sets, so it
+is `lookahead-stereo`'s (`STEREO_ROUTE`).
 """
 
 from __future__ import annotations
@@ -132,6 +124,8 @@ validation buildings over nine start views: 95.32 % against 94.42, the worst bui
 against 0.06 under, both courtyards up by 1.0 and 1.3)."""
 PARTNER_SIDES = ("back", "forward", "up")
 """Back or forward along the view's orbit, or up its meridian."""
+BANDS = (2, 3)
+"""The vertical bands a side may be told apart by (`LookaheadOptions.bands`)."""
 DEPTH_SOURCES = ("camera", "stereo")
 """Where the look-ahead's depth comes from: a depth camera, or plane-sweep stereo on two frames a view."""
 FORWARD_STEP = 2 / 13
@@ -197,6 +191,9 @@ class LookaheadOptions:
     sectors: int = 4
     """With `sides`, the horizontal directions a side is measured from: 4 quadrants or 8 sectors
     (`OccupancyGrid`'s `sectors`; round 45)."""
+    bands: int = 3
+    """With `sides`, the vertical bands a side is told by: 3 (`sight_bin`'s down, level, up) or 2 (down and
+    level one: a wall seen from above is seen, only an underside needs a view from below; round 48)."""
     steep_measures: bool = True
     """With `steep_deg`, whether the steep band is a direction like the others (round 35) or measures no
     side (round 36): a steep ray then neither marks the side it meets as measured nor gains a view anything
@@ -223,10 +220,11 @@ class LookaheadOptions:
             raise ValueError(f"lookahead's flight allowance, excess weight and battery a view are finite and "
                              f">= 0, got {self.allowance_m}, {self.excess}, {self.battery_per_view_m}")
         if not 0 <= self.sides < float("inf") or not 0 <= self.steep_deg < 90 \
-                or not 0 <= self.ceiling_deg <= 90 or self.sectors not in SECTORS:
+                or not 0 <= self.ceiling_deg <= 90 or self.sectors not in SECTORS or self.bands not in BANDS:
             raise ValueError(f"lookahead's weight of a side never measured is finite and >= 0, its steep "
                              f"band under 90 degrees, its ceiling at most 90 (0: none), its sectors 4 or "
-                             f"8, got {self.sides}, {self.steep_deg}, {self.ceiling_deg}, {self.sectors}")
+                             f"8, its bands 2 or 3, got {self.sides}, {self.steep_deg}, {self.ceiling_deg}, "
+                             f"{self.sectors}, {self.bands}")
         if not 0 <= self.spacing_m < float("inf") or not 0 <= self.sight_deg < 180:
             raise ValueError(f"lookahead's spacing is a finite distance >= 0 and its sight rule 0 to 180 "
                              f"degrees (0: none), got {self.spacing_m}, {self.sight_deg}")
@@ -300,7 +298,7 @@ class LookaheadPlanner(Planner):
                 if options.next_to_free:
                     seen[key] &= edge
                 if options.sides:  # then (occupied voxel, direction) items: `side_items`
-                    seen[key] = np.concatenate([seen[key], sighted[np.ix_(occupied, columns)].reshape(-1)])
+                    seen[key] = np.concatenate([seen[key], sighted[occupied][:, columns].any(-1).reshape(-1)])
             return seen[key]
 
         def step(action: np.ndarray, view: Viewpoint) -> Viewpoint:
@@ -372,19 +370,26 @@ class LookaheadPlanner(Planner):
 def side_items(grid: OccupancyGrid, occupied: np.ndarray, known: np.ndarray, sides: float,
                columns: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
     """The look-ahead's samples with `sides` > 0: the grid's voxels (`known`), then each `occupied` voxel's
-    directions `columns` (`side_columns`), known where it has been measured from that direction
-    (`OccupancyGrid.sides`); and their worth (1 a voxel, `sides` a direction). Without, `known` and None."""
+    sides, the rows of sight bins `columns` (`side_columns`), known where it has been measured from any of a
+    row's bins (`OccupancyGrid.sides`); and their worth (1 a voxel, `sides` a side). Without, `known` and
+    None."""
     if not sides:
         return known, None
-    measured = (grid.sides[occupied, None] >> columns.astype(grid.sides.dtype)) & 1
+    masks = np.bitwise_or.reduce(np.left_shift(1, columns).astype(grid.sides.dtype), axis=1)
+    measured = (grid.sides[occupied, None] & masks) != 0
     weights = np.concatenate([np.ones(len(known)), np.full(measured.size, sides)])
-    return np.concatenate([known, measured.astype(bool).reshape(-1)]), weights
+    return np.concatenate([known, measured.reshape(-1)]), weights
 
 
 def side_columns(grid: OccupancyGrid, options: LookaheadOptions) -> np.ndarray:
-    """The grid's sight bins that count as sides: all, or without `steep_measures` all but the steep band's
-    (`OccupancyGrid.side_bins`)."""
-    return np.arange(grid.sight_bins) if options.steep_measures else grid.side_bins()
+    """The sides, rows of the grid's sight bins that count as one: each bin, or without `steep_measures` each
+    but the steep band's (`OccupancyGrid.side_bins`); with 2 `bands`, a sector's down and level bins one row
+    (a row of one bin repeats it)."""
+    bins = np.arange(grid.sight_bins) if options.steep_measures else grid.side_bins()
+    if options.bands == 3:
+        return bins[:, None]
+    band = bins % (4 if grid.steep_deg else 3) - bool(grid.steep_deg)  # -1 steep, 0 down, 1 level, 2 up
+    return np.array([[b, b + 1 if k == 0 else b] for b, k in zip(bins, band, strict=True) if k != 1])
 
 
 def stereo_partner(view: Viewpoint, baseline: float = STEREO_BASELINE_M, side: str = "back") -> Viewpoint:

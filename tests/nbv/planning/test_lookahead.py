@@ -26,6 +26,7 @@ from nbv.planning.lookahead import (
     LookaheadPlanner,
     lookahead_planner,
     side_columns,
+    side_items,
     stereo_lookahead_planner,
     stereo_partner,
 )
@@ -161,7 +162,7 @@ def test_valuing_unmeasured_sides_changes_a_looking_flight_but_not_a_blind_one()
     assert tiny(0.0, "stereo", True, forward=True, sides=50.0).plan(world, 3) == blind  # nothing measured
     with pytest.raises(ValueError, match="weight of a side never measured is finite and >= 0, its steep band "
                                          "under 90 degrees, its ceiling at most 90 .0: none., its sectors 4 "
-                                         "or 8, got -1"):
+                                         "or 8, its bands 2 or 3, got -1"):
         LookaheadOptions(sides=-1)
 
 
@@ -170,8 +171,33 @@ def test_eight_sectors_change_a_flight_that_values_sides_and_only_that():
     plain, sides = tiny(0.0, forward=True).plan(world, 4), tiny(0.0, forward=True, sides=50.0).plan(world, 4)
     assert tiny(0.0, forward=True, sectors=8).plan(world, 4) == plain  # no sides valued: no change
     assert tiny(0.0, forward=True, sides=50.0, sectors=8).plan(world, 4) != sides
-    with pytest.raises(ValueError, match="its sectors 4 or 8, got 0.0, 0.0, 0.0, 6"):
+    with pytest.raises(ValueError, match="its sectors 4 or 8, its bands 2 or 3, got 0.0, 0.0, 0.0, 6, 3"):
         LookaheadOptions(sectors=6)
+
+
+def test_two_bands_make_a_sectors_down_and_level_bins_one_side():
+    steep = OccupancyGrid(np.zeros(3), np.ones(3), resolution=2, steep_deg=60)  # [steep,] down, level, up
+    blind = side_columns(steep, LookaheadOptions(bands=2, steep_measures=False))
+    assert blind.tolist() == [[1, 2], [3, 3], [5, 6], [7, 7], [9, 10], [11, 11], [13, 14], [15, 15]]
+    assert side_columns(steep, LookaheadOptions(bands=2)).tolist()[:3] == [[0, 0], [1, 2], [3, 3]]
+    plain = OccupancyGrid(np.zeros(3), np.ones(3), resolution=2)
+    assert side_columns(plain, LookaheadOptions(bands=2)).tolist()[:4] == [[0, 1], [2, 2], [3, 4], [5, 5]]
+    plain.sides[:] = [1 << 1, 1 << 2, 1 << 0, 0, 0, 0, 0, 0]  # measured level, up, down in quadrant 0
+    occupied = np.array([0, 1, 2])
+    known, weights = side_items(plain, occupied, np.zeros(8, bool), 0.5,
+                                side_columns(plain, LookaheadOptions(bands=2)))
+    sides = known[8:].reshape(3, 8)[:, :2]  # quadrant 0's down-or-level side, then its up side
+    assert sides.tolist() == [[True, False], [False, True], [True, False]]
+    assert weights.tolist() == [1.0] * 8 + [0.5] * 24
+
+
+def test_two_bands_change_a_flight_that_values_sides_and_only_that():
+    world = PlanningWorld(config(), seed=3)
+    plain, sides = tiny(0.0, forward=True).plan(world, 4), tiny(0.0, forward=True, sides=50.0).plan(world, 4)
+    assert tiny(0.0, forward=True, bands=2).plan(world, 4) == plain  # no sides valued: no change
+    assert tiny(0.0, forward=True, sides=50.0, bands=2).plan(world, 4) != sides
+    with pytest.raises(ValueError, match="its bands 2 or 3, got 0.0, 0.0, 0.0, 4, 1"):
+        LookaheadOptions(bands=1)
 
 
 def test_a_steep_band_changes_a_flight_that_values_sides_and_only_that():
@@ -180,17 +206,17 @@ def test_a_steep_band_changes_a_flight_that_values_sides_and_only_that():
     assert tiny(0.0, forward=True, steep_deg=60.0).plan(world, 4) == plain  # no sides valued: no change
     assert tiny(0.0, forward=True, sides=50.0, steep_deg=60.0).plan(world, 4) != sides
     with pytest.raises(ValueError, match="steep band under 90 degrees, its ceiling at most 90 .0: none., its "
-                                         "sectors 4 or 8, got 0.0, 90"):
+                                         "sectors 4 or 8, its bands 2 or 3, got 0.0, 90"):
         LookaheadOptions(steep_deg=90)
 
 
 def test_a_steep_band_that_measures_no_side_drops_its_bins_and_flies_otherwise():
     grid = OccupancyGrid(np.zeros(3), np.ones(3), resolution=2, steep_deg=60)
-    assert side_columns(grid, LookaheadOptions()).tolist() == list(range(16))
-    assert side_columns(grid, LookaheadOptions(steep_measures=False)).tolist() == \
+    assert side_columns(grid, LookaheadOptions()).ravel().tolist() == list(range(16))
+    assert side_columns(grid, LookaheadOptions(steep_measures=False)).ravel().tolist() == \
         [1, 2, 3, 5, 6, 7, 9, 10, 11, 13, 14, 15]  # each quadrant's down, level and up
     plain = OccupancyGrid(np.zeros(3), np.ones(3), resolution=2)
-    assert side_columns(plain, LookaheadOptions(steep_measures=False)).tolist() == list(range(12))
+    assert side_columns(plain, LookaheadOptions(steep_measures=False)).ravel().tolist() == list(range(12))
     world = PlanningWorld(config(), seed=3)
     steep = tiny(0.0, forward=True, sides=50.0, steep_deg=60.0).plan(world, 4)
     assert tiny(0.0, forward=True, sides=50.0, steep_deg=60.0, steep_measures=False).plan(world, 4) != steep
@@ -361,5 +387,6 @@ def test_a_ceiling_holds_every_step_at_or_under_it_and_changes_a_climbing_flight
     assert max(v.elevation for v in free[1:]) > np.radians(30)  # the free flight climbs past it
     held = tiny(0.0, forward=True, sides=50.0, ceiling_deg=30.0).plan(world, 6)
     assert held != free and max(v.elevation for v in held[1:]) <= np.radians(30) + 1e-12
-    with pytest.raises(ValueError, match="at most 90 .0: none., its sectors 4 or 8, got 0.0, 0.0, 91, 4"):
+    with pytest.raises(ValueError, match="at most 90 .0: none., its sectors 4 or 8, its bands 2 or 3, got "
+                                         "0.0, 0.0, 91, 4, 3"):
         LookaheadOptions(ceiling_deg=91)

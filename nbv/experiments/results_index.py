@@ -155,6 +155,9 @@ INDEX = (
     Result("selection/round46/README.md", "selection/round46/reference/results.json",
            "its forty-sixth round, a diagnostic: lookahead-stereo and eight sectors on four training "
            "courtyards no round chose on", LOOKS_EVAL),
+    Result("selection/round47/README.md", "selection/round47/steep70/results.json",
+           "its forty-seventh round: exact depth on the fresh courtyards, the steep band at 70 and 75 "
+           "degrees (missed its bar, not adopted)", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

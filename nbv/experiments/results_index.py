@@ -158,6 +158,9 @@ INDEX = (
     Result("selection/round47/README.md", "selection/round47/steep70/results.json",
            "its forty-seventh round: exact depth on the fresh courtyards, the steep band at 70 and 75 "
            "degrees (missed its bar, not adopted)", LOOKS_EVAL),
+    Result("selection/round48/README.md", "selection/round48/bands2/results.json",
+           "its forty-eighth round: sides told by two vertical bands (missed its bar, not adopted)",
+           LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

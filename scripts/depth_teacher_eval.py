@@ -26,7 +26,8 @@ or under C degrees of elevation (_ceC). Round 38: `--pace` charges the hinge on 
 even share of the battery (_pc). Round 39: `--route` plans every view still to take together as one
 route, re-planned at each view (_rt). Round 40: `--restarts N` also improves N routes of random steps
 (_rsN). Round 45: `--sectors 8` measures sides from eight 45-degree horizontal sectors, not quadrants (_sc8).
-Round 48: `--bands 2` tells sides by two vertical bands, down and level one (_bd2).
+Round 48: `--bands 2` tells sides by two vertical bands, down and level one (_bd2); round 49: `--bands 1` by
+none (_bd1).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -102,7 +103,7 @@ def arguments() -> argparse.Namespace:
     parser.add_argument("--sectors", type=int, default=4, choices=SECTORS,
                         help="with --sides, a side is measured from one of 4 quadrants or 8 sectors")
     parser.add_argument("--bands", type=int, default=3, choices=BANDS,
-                        help="with --sides, a side is told by 3 vertical bands or 2 (down and level one)")
+                        help="with --sides, a side is told by 3 vertical bands, 2 (down and level one) or 1")
     parser.add_argument("--steep-blind", action="store_true",
                         help="with --steep, the steep band measures no side (neither marks nor gains one)")
     parser.add_argument("--ceiling", type=float, default=0.0,

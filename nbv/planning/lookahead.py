@@ -124,7 +124,7 @@ validation buildings over nine start views: 95.32 % against 94.42, the worst bui
 against 0.06 under, both courtyards up by 1.0 and 1.3)."""
 PARTNER_SIDES = ("back", "forward", "up")
 """Back or forward along the view's orbit, or up its meridian."""
-BANDS = (2, 3)
+BANDS = (1, 2, 3)
 """The vertical bands a side may be told apart by (`LookaheadOptions.bands`)."""
 DEPTH_SOURCES = ("camera", "stereo")
 """Where the look-ahead's depth comes from: a depth camera, or plane-sweep stereo on two frames a view."""
@@ -192,8 +192,8 @@ class LookaheadOptions:
     """With `sides`, the horizontal directions a side is measured from: 4 quadrants or 8 sectors
     (`OccupancyGrid`'s `sectors`; round 45)."""
     bands: int = 3
-    """With `sides`, the vertical bands a side is told by: 3 (`sight_bin`'s down, level, up) or 2 (down and
-    level one: a wall seen from above is seen, only an underside needs a view from below; round 48)."""
+    """With `sides`, the vertical bands a side is told by: 3 (`sight_bin`'s down, level, up), 2 (down and
+    level one: a wall seen from above is seen; round 48) or 1 (a sector's side, from any height; round 49)."""
     steep_measures: bool = True
     """With `steep_deg`, whether the steep band is a direction like the others (round 35) or measures no
     side (round 36): a steep ray then neither marks the side it meets as measured nor gains a view anything
@@ -223,7 +223,7 @@ class LookaheadOptions:
                 or not 0 <= self.ceiling_deg <= 90 or self.sectors not in SECTORS or self.bands not in BANDS:
             raise ValueError(f"lookahead's weight of a side never measured is finite and >= 0, its steep "
                              f"band under 90 degrees, its ceiling at most 90 (0: none), its sectors 4 or "
-                             f"8, its bands 2 or 3, got {self.sides}, {self.steep_deg}, {self.ceiling_deg}, "
+                             f"8, its bands 1 to 3, got {self.sides}, {self.steep_deg}, {self.ceiling_deg}, "
                              f"{self.sectors}, {self.bands}")
         if not 0 <= self.spacing_m < float("inf") or not 0 <= self.sight_deg < 180:
             raise ValueError(f"lookahead's spacing is a finite distance >= 0 and its sight rule 0 to 180 "
@@ -383,13 +383,13 @@ def side_items(grid: OccupancyGrid, occupied: np.ndarray, known: np.ndarray, sid
 
 def side_columns(grid: OccupancyGrid, options: LookaheadOptions) -> np.ndarray:
     """The sides, rows of the grid's sight bins that count as one: each bin, or without `steep_measures` each
-    but the steep band's (`OccupancyGrid.side_bins`); with 2 `bands`, a sector's down and level bins one row
-    (a row of one bin repeats it)."""
+    but the steep band's (`OccupancyGrid.side_bins`); with 2 `bands` a sector's down and level bins one row,
+    with 1 its down, level and up bins (a row of one bin repeats it)."""
     bins = np.arange(grid.sight_bins) if options.steep_measures else grid.side_bins()
-    if options.bands == 3:
-        return bins[:, None]
     band = bins % (4 if grid.steep_deg else 3) - bool(grid.steep_deg)  # -1 steep, 0 down, 1 level, 2 up
-    return np.array([[b, b + 1 if k == 0 else b] for b, k in zip(bins, band, strict=True) if k != 1])
+    width = 4 - options.bands  # the bins of a down row
+    return np.array([[b + k for k in range(width)] if kind == 0 else [b] * width
+                     for b, kind in zip(bins, band, strict=True) if not 0 < kind < width])
 
 
 def stereo_partner(view: Viewpoint, baseline: float = STEREO_BASELINE_M, side: str = "back") -> Viewpoint:

@@ -162,7 +162,7 @@ def test_valuing_unmeasured_sides_changes_a_looking_flight_but_not_a_blind_one()
     assert tiny(0.0, "stereo", True, forward=True, sides=50.0).plan(world, 3) == blind  # nothing measured
     with pytest.raises(ValueError, match="weight of a side never measured is finite and >= 0, its steep band "
                                          "under 90 degrees, its ceiling at most 90 .0: none., its sectors 4 "
-                                         "or 8, its bands 2 or 3, got -1"):
+                                         "or 8, its bands 1 to 3, got -1"):
         LookaheadOptions(sides=-1)
 
 
@@ -171,17 +171,20 @@ def test_eight_sectors_change_a_flight_that_values_sides_and_only_that():
     plain, sides = tiny(0.0, forward=True).plan(world, 4), tiny(0.0, forward=True, sides=50.0).plan(world, 4)
     assert tiny(0.0, forward=True, sectors=8).plan(world, 4) == plain  # no sides valued: no change
     assert tiny(0.0, forward=True, sides=50.0, sectors=8).plan(world, 4) != sides
-    with pytest.raises(ValueError, match="its sectors 4 or 8, its bands 2 or 3, got 0.0, 0.0, 0.0, 6, 3"):
+    with pytest.raises(ValueError, match="its sectors 4 or 8, its bands 1 to 3, got 0.0, 0.0, 0.0, 6, 3"):
         LookaheadOptions(sectors=6)
 
 
-def test_two_bands_make_a_sectors_down_and_level_bins_one_side():
+def test_fewer_bands_make_a_sectors_vertical_bins_one_side():
     steep = OccupancyGrid(np.zeros(3), np.ones(3), resolution=2, steep_deg=60)  # [steep,] down, level, up
     blind = side_columns(steep, LookaheadOptions(bands=2, steep_measures=False))
     assert blind.tolist() == [[1, 2], [3, 3], [5, 6], [7, 7], [9, 10], [11, 11], [13, 14], [15, 15]]
     assert side_columns(steep, LookaheadOptions(bands=2)).tolist()[:3] == [[0, 0], [1, 2], [3, 3]]
     plain = OccupancyGrid(np.zeros(3), np.ones(3), resolution=2)
     assert side_columns(plain, LookaheadOptions(bands=2)).tolist()[:4] == [[0, 1], [2, 2], [3, 4], [5, 5]]
+    assert side_columns(steep, LookaheadOptions(bands=1)).tolist()[:3] == [[0, 0, 0], [1, 2, 3], [4, 4, 4]]
+    assert side_columns(plain, LookaheadOptions(bands=1, steep_measures=False)).tolist() == \
+        [[0, 1, 2], [3, 4, 5], [6, 7, 8], [9, 10, 11]]
     plain.sides[:] = [1 << 1, 1 << 2, 1 << 0, 0, 0, 0, 0, 0]  # measured level, up, down in quadrant 0
     occupied = np.array([0, 1, 2])
     known, weights = side_items(plain, occupied, np.zeros(8, bool), 0.5,
@@ -196,8 +199,8 @@ def test_two_bands_change_a_flight_that_values_sides_and_only_that():
     plain, sides = tiny(0.0, forward=True).plan(world, 4), tiny(0.0, forward=True, sides=50.0).plan(world, 4)
     assert tiny(0.0, forward=True, bands=2).plan(world, 4) == plain  # no sides valued: no change
     assert tiny(0.0, forward=True, sides=50.0, bands=2).plan(world, 4) != sides
-    with pytest.raises(ValueError, match="its bands 2 or 3, got 0.0, 0.0, 0.0, 4, 1"):
-        LookaheadOptions(bands=1)
+    with pytest.raises(ValueError, match="its bands 1 to 3, got 0.0, 0.0, 0.0, 4, 0"):
+        LookaheadOptions(bands=0)
 
 
 def test_a_steep_band_changes_a_flight_that_values_sides_and_only_that():
@@ -206,7 +209,7 @@ def test_a_steep_band_changes_a_flight_that_values_sides_and_only_that():
     assert tiny(0.0, forward=True, steep_deg=60.0).plan(world, 4) == plain  # no sides valued: no change
     assert tiny(0.0, forward=True, sides=50.0, steep_deg=60.0).plan(world, 4) != sides
     with pytest.raises(ValueError, match="steep band under 90 degrees, its ceiling at most 90 .0: none., its "
-                                         "sectors 4 or 8, its bands 2 or 3, got 0.0, 90"):
+                                         "sectors 4 or 8, its bands 1 to 3, got 0.0, 90"):
         LookaheadOptions(steep_deg=90)
 
 
@@ -387,6 +390,6 @@ def test_a_ceiling_holds_every_step_at_or_under_it_and_changes_a_climbing_flight
     assert max(v.elevation for v in free[1:]) > np.radians(30)  # the free flight climbs past it
     held = tiny(0.0, forward=True, sides=50.0, ceiling_deg=30.0).plan(world, 6)
     assert held != free and max(v.elevation for v in held[1:]) <= np.radians(30) + 1e-12
-    with pytest.raises(ValueError, match="at most 90 .0: none., its sectors 4 or 8, its bands 2 or 3, got "
+    with pytest.raises(ValueError, match="at most 90 .0: none., its sectors 4 or 8, its bands 1 to 3, got "
                                          "0.0, 0.0, 91, 4, 3"):
         LookaheadOptions(ceiling_deg=91)

@@ -166,13 +166,22 @@ def test_valuing_unmeasured_sides_changes_a_looking_flight_but_not_a_blind_one()
         LookaheadOptions(sides=-1)
 
 
-def test_eight_sectors_change_a_flight_that_values_sides_and_only_that():
+@pytest.mark.parametrize("option", [{"sectors": 8}, {"bands": 2}, {"bands": 1}, {"steep_deg": 60.0}])
+def test_a_sides_option_changes_a_flight_that_values_sides_and_only_that(option):
     world = PlanningWorld(config(), seed=3)
     plain, sides = tiny(0.0, forward=True).plan(world, 4), tiny(0.0, forward=True, sides=50.0).plan(world, 4)
-    assert tiny(0.0, forward=True, sectors=8).plan(world, 4) == plain  # no sides valued: no change
-    assert tiny(0.0, forward=True, sides=50.0, sectors=8).plan(world, 4) != sides
-    with pytest.raises(ValueError, match="its sectors 4 or 8, its bands 1 to 3, got 0.0, 0.0, 0.0, 6, 3"):
-        LookaheadOptions(sectors=6)
+    assert tiny(0.0, forward=True, **option).plan(world, 4) == plain  # no sides valued: no change
+    assert tiny(0.0, forward=True, sides=50.0, **option).plan(world, 4) != sides
+
+
+@pytest.mark.parametrize(("option", "message"), [
+    ({"sectors": 6}, "its sectors 4 or 8, its bands 1 to 3, got 0.0, 0.0, 0.0, 6, 3"),
+    ({"bands": 0}, "its bands 1 to 3, got 0.0, 0.0, 0.0, 4, 0"),
+    ({"steep_deg": 90}, "steep band under 90 degrees, its ceiling at most 90 .0: none., its sectors 4 or "
+                        "8, its bands 1 to 3, got 0.0, 90")])
+def test_a_sides_option_out_of_range_is_refused(option, message):
+    with pytest.raises(ValueError, match=message):
+        LookaheadOptions(**option)
 
 
 def test_fewer_bands_make_a_sectors_vertical_bins_one_side():
@@ -192,25 +201,6 @@ def test_fewer_bands_make_a_sectors_vertical_bins_one_side():
     sides = known[8:].reshape(3, 8)[:, :2]  # quadrant 0's down-or-level side, then its up side
     assert sides.tolist() == [[True, False], [False, True], [True, False]]
     assert weights.tolist() == [1.0] * 8 + [0.5] * 24
-
-
-def test_two_bands_change_a_flight_that_values_sides_and_only_that():
-    world = PlanningWorld(config(), seed=3)
-    plain, sides = tiny(0.0, forward=True).plan(world, 4), tiny(0.0, forward=True, sides=50.0).plan(world, 4)
-    assert tiny(0.0, forward=True, bands=2).plan(world, 4) == plain  # no sides valued: no change
-    assert tiny(0.0, forward=True, sides=50.0, bands=2).plan(world, 4) != sides
-    with pytest.raises(ValueError, match="its bands 1 to 3, got 0.0, 0.0, 0.0, 4, 0"):
-        LookaheadOptions(bands=0)
-
-
-def test_a_steep_band_changes_a_flight_that_values_sides_and_only_that():
-    world = PlanningWorld(config(), seed=3)
-    plain, sides = tiny(0.0, forward=True).plan(world, 4), tiny(0.0, forward=True, sides=50.0).plan(world, 4)
-    assert tiny(0.0, forward=True, steep_deg=60.0).plan(world, 4) == plain  # no sides valued: no change
-    assert tiny(0.0, forward=True, sides=50.0, steep_deg=60.0).plan(world, 4) != sides
-    with pytest.raises(ValueError, match="steep band under 90 degrees, its ceiling at most 90 .0: none., its "
-                                         "sectors 4 or 8, its bands 1 to 3, got 0.0, 90"):
-        LookaheadOptions(steep_deg=90)
 
 
 def test_a_steep_band_that_measures_no_side_drops_its_bins_and_flies_otherwise():

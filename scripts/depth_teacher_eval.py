@@ -27,7 +27,7 @@ even share of the battery (_pc). Round 39: `--route` plans every view still to t
 route, re-planned at each view (_rt). Round 40: `--restarts N` also improves N routes of random steps
 (_rsN). Round 45: `--sectors 8` measures sides from eight 45-degree horizontal sectors, not quadrants (_sc8).
 Round 48: `--bands 2` tells sides by two vertical bands, down and level one (_bd2); round 49: `--bands 1` by
-none (_bd1).
+none (_bd1). Round 50: `--padding-free` starts the grid's padding, outside the target's bounds, free (_pf).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -102,8 +102,8 @@ def arguments() -> argparse.Namespace:
                              "direction of their own (0: none)")
     parser.add_argument("--sectors", type=int, default=4, choices=SECTORS,
                         help="with --sides, a side is measured from one of 4 quadrants or 8 sectors")
-    parser.add_argument("--bands", type=int, default=3, choices=BANDS,
-                        help="with --sides, a side is told by 3 vertical bands, 2 (down and level one) or 1")
+    parser.add_argument("--padding-free", action="store_true", help="the grid's padding starts free")
+    parser.add_argument("--bands", type=int, default=3, choices=BANDS, help="with --sides, vertical bands")
     parser.add_argument("--steep-blind", action="store_true",
                         help="with --steep, the steep band measures no side (neither marks nor gains one)")
     parser.add_argument("--ceiling", type=float, default=0.0,
@@ -129,6 +129,7 @@ def named(options: LookaheadOptions) -> str:
         + ("_fw" if o.forward else "") + (f"_sp{o.spacing_m:g}" if o.spacing_m else "") \
         + (f"_si{o.sight_deg:g}" if o.sight_deg else "") + (f"_sd{o.sides:g}" if o.sides else "") \
         + (f"_sc{o.sectors}" if o.sectors != 4 else "") + (f"_bd{o.bands}" if o.bands != 3 else "") \
+        + ("_pf" if o.padding_free else "") \
         + (f"_stp{o.steep_deg:g}" + "b" * (not o.steep_measures) if o.steep_deg else "") \
         + (f"_ce{o.ceiling_deg:g}" if o.ceiling_deg else "") + ("_pc" if o.pace else "") \
         + ("_rt" if o.route else "") + (f"_rs{o.restarts}" if o.restarts else "")
@@ -152,7 +153,7 @@ def main() -> None:
                                patience=args.patience, horizon=args.horizon, next_to_free=args.next_to_free,
                                forward=args.forward, spacing_m=args.spacing, sight_deg=args.sight,
                                sides=args.sides, battery_per_view_m=args.per_view, steep_deg=args.steep,
-                               sectors=args.sectors, bands=args.bands,
+                               sectors=args.sectors, bands=args.bands, padding_free=args.padding_free,
                                steep_measures=not args.steep_blind, ceiling_deg=args.ceiling, pace=args.pace,
                                route=args.route, restarts=args.restarts)
     paired = replace(options, partners=tuple(args.partners), agree=args.agree, votes=args.votes)

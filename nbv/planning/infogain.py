@@ -30,7 +30,7 @@ import numpy as np
 from nbv.planning.base import Planner, check_candidates, sample_viewpoints
 from nbv.planning.linking import FlownLinks, pick_linked
 from nbv.recon.config import OccupancyConfig
-from nbv.recon.occupancy import OccupancyGrid
+from nbv.recon.occupancy import FREE, OccupancyGrid
 from nbv.sfm.config import LinkSettings
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from scenes.model import Scene
@@ -41,16 +41,26 @@ if TYPE_CHECKING:
 
 
 def target_grid(scene: Scene, config: OccupancyConfig, steep_deg: float = 0.0,
-                sectors: int = 4) -> OccupancyGrid:
+                sectors: int = 4, padding_free: bool = False) -> OccupancyGrid:
     """An all-unknown grid over the scene's target bounds, padded by the margin on the sides and the top
-    (`steep_deg` and `sectors`: the grid's sight directions, which only the look-ahead's sides use)."""
+    (`steep_deg` and `sectors`: the grid's sight directions, which only the look-ahead's sides use); with
+    `padding_free` the voxels wholly outside the bounds start free: no target surface can be there."""
     if not scene.parts:
         raise ValueError(f"scene {scene.name!r} is a Mitsuba XML file: the infogain planner needs the "
                          "target's bounds, which it does not give")
     lower, upper = scene.bounds()
     margin = config.grid_margin_m
-    return OccupancyGrid(lower - [margin, margin, 0.0], upper + margin, config.grid_resolution, config.votes,
+    grid = OccupancyGrid(lower - [margin, margin, 0.0], upper + margin, config.grid_resolution, config.votes,
                          steep_deg, sectors)
+    if padding_free:
+        grid.state[outside(grid, lower, upper)] = FREE
+    return grid
+
+
+def outside(grid: OccupancyGrid, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """Which of the grid's voxels (bool, the grid's shape) lie wholly outside the box `lower` to `upper`."""
+    corner = grid.lower + np.moveaxis(np.indices(grid.state.shape), 0, -1) * grid.voxel_size
+    return np.any((corner >= upper - 1e-9) | (corner + grid.voxel_size <= lower + 1e-9), axis=-1)
 
 
 class InfoGainPlanner(Planner):

@@ -29,32 +29,30 @@ the teacher's steps (paper_results/online/stereo in git at e7f44fa): 3.8 points 
 metres, 31.3 lost with blank frames, 3.4 under the ring on the walled compound. Rounds 26, 27, 29 and 30
 (paper_results/selection, docs/rl.md) tried the options below on the validation buildings, none passing more
 checks (`partners`, `agree`, `votes`, `frontier`, `patience`, `horizon`, `next_to_free`, `spacing_m`,
-`sight_deg`), so none is a default. Round 28 (paper_results/selection/round28) flew it on the forward steps of
-a pilot's orbit (`forward`): five of six checks on the validation buildings, so they are `lookahead-stereo`'s
-steps (`STEREO_FORWARD`). Held out, scored once (paper_results/online/stereo): 3.9 points above the ring in
-1.29x its metres, 4.3 lost with blank frames, 1.7 under the ring on the walled compound, where it ends its
-flights near-hovering at 80 degrees (a forward step there is an arc of 0.13 m). Round 31
+`sight_deg`; round 38's `pace`), so none is a default. Round 28 (paper_results/selection/round28) flew it on
+the forward steps of a pilot's orbit (`forward`): five of six checks on the validation buildings, so they are
+`lookahead-stereo`'s steps (`STEREO_FORWARD`). Held out, scored once (paper_results/online/stereo): 3.9 points
+above the ring in 1.29x its metres, 4.3 lost with blank frames, 1.7 under the ring on the walled compound,
+where it ends its flights near-hovering at 80 degrees (a forward step there is an arc of 0.13 m). Round 31
 (paper_results/selection/round31) found what the grid cannot see: an occupied voxel holds every face of the
 surface in it, so the underside of a tower's top, seen only from the low ring, counts as known once seen from
 above. With `sides` a view also gains for each occupied voxel it would meet from a direction never measured
 (`OccupancyGrid.sighted`); under a battery's hinge (2 a metre past 13 m) that passed five of six checks with
 the worst building 0.4 under the ring (round 28's 0.6) in 1.44x its metres, so it is `lookahead-stereo`'s
 setting (`STEREO_SIDES`, `STEREO_HINGE`). The hinge's 13 m stopped it at 13 m at any view budget (`make
-tables`' budget part); round 33 (paper_results/selection/round33) let the battery follow the budget, one metre
-a view past 13 views (`battery_per_view_m`, `STEREO_PER_VIEW`): more coverage at 16 views, so it is the
-default. Round 35 (paper_results/selection/round35) gave rays looking down more steeply than 60 degrees sight
-bins of their own (`steep_deg`): that drew views to nearly overhead, so not the default. Round 36 made that
-band measure no side (`steep_measures` off: a wall seen only from overhead, at a grazing angle, stays
-unmeasured, and a view gains nothing for the sides it meets steeply) or held every step under 45 degrees
-(`ceiling_deg`): more coverage but not the courtyard gain its rule asked; round 37 confirmed the blind band
-from start views never flown (paper_results/selection/round37), so it is `lookahead-stereo`'s
-(`STEREO_STEEP`). Held out, scored once (paper_results/online/stereo, at 05e7f11): 4.4 points above the ring
-in 1.46x its metres, 3.9 above random views on the courtyard (the bar is 5), five of six checks as round 31's
-setting. Round 38 (paper_results/selection/round38) spent the battery at an even pace (`pace`): both
-courtyards lower, so off. Round 39 (paper_results/selection/round39) chose every view still to take together,
-as one route re-planned at each view (`route`, `nbv.planning.route`): 0.9 points more coverage over nine start
-views, the worst building 1.0 above the ring, both courtyards up, five of six checks on both start sets, so it
-is `lookahead-stereo`'s (`STEREO_ROUTE`).
+tables`' budget part); round 33 let the battery follow the budget, one metre a view past 13 views
+(`battery_per_view_m`, `STEREO_PER_VIEW`): more coverage at 16 views, so it is the default. Round 35 gave rays
+looking down more steeply than 60 degrees sight bins of their own (`steep_deg`): that drew views to nearly
+overhead, so not the default. Round 36 made that band measure no side (`steep_measures` off: a wall seen only
+from overhead, at a grazing angle, stays unmeasured, and a view gains nothing for the sides it meets steeply)
+or held every step under 45 degrees (`ceiling_deg`): more coverage but not the courtyard gain its rule asked;
+round 37 confirmed the blind band from start views never flown (paper_results/selection/round37), so it is
+`lookahead-stereo`'s (`STEREO_STEEP`). Held out, scored once (paper_results/online/stereo, at 05e7f11): 4.4
+points above the ring in 1.46x its metres, 3.9 above random views on the courtyard (the bar is 5), five of six
+checks as round 31's setting. Round 39 (paper_results/selection/round39) chose every view still to take
+together, as one route re-planned at each view (`route`, `nbv.planning.route`): 0.9 points more coverage over
+nine start views, the worst building 1.0 above the ring, both courtyards up, five of six checks on both start
+sets, so it is `lookahead-stereo`'s (`STEREO_ROUTE`).
 """
 
 from __future__ import annotations
@@ -191,6 +189,8 @@ class LookaheadOptions:
     sectors: int = 4
     """With `sides`, the horizontal directions a side is measured from: 4 quadrants or 8 sectors
     (`OccupancyGrid`'s `sectors`; round 45)."""
+    padding_free: bool = False
+    """The grid's padding (voxels wholly outside the target's bounds) is free at first (round 50)."""
     bands: int = 3
     """With `sides`, the vertical bands a side is told by: 3 (`sight_bin`'s down, level, up), 2 (down and
     level one: a wall seen from above is seen; round 48) or 1 (a sector's side, from any height; round 49)."""
@@ -283,7 +283,7 @@ class LookaheadPlanner(Planner):
         camera, center, options = world.camera, world.target.center(), self.options
         stride = max(1, round(camera.width / self.rays))
         occupancy = OccupancyConfig(grid_resolution=self.grid, gain_ray_stride=stride, votes=options.votes)
-        grid = target_grid(world.target, occupancy, options.steep_deg, options.sectors)
+        grid = target_grid(world.target, occupancy, options.steep_deg, options.sectors, options.padding_free)
         steps = replace(world.env, action_mode="forward", relative_step=FORWARD_STEP) if options.forward \
             else replace(world.env, action_mode="orbit", relative_step=ORBIT_STEP)
 

@@ -7,11 +7,11 @@ import numpy as np
 from nbv.bov.config import BoVConfig
 from nbv.features.config import FeatureConfig
 from nbv.planning.config import PlanSettings
-from nbv.planning.infogain import InfoGainPlanner, target_grid
+from nbv.planning.infogain import InfoGainPlanner, outside, target_grid
 from nbv.planning.registry import make_planner
 from nbv.planning.world import PlanningWorld
 from nbv.recon.config import OccupancyConfig
-from nbv.recon.occupancy import UNKNOWN, OccupancyGrid
+from nbv.recon.occupancy import FREE, UNKNOWN, OccupancyGrid
 from nbv.rl.config import EnvConfig
 from render.camera import UAVCamera
 from render.settings import RenderSettings
@@ -55,3 +55,17 @@ def test_the_grid_covers_the_padded_target_bounds_and_starts_unknown():
     assert np.allclose(grid.lower, lower - [0.05, 0.05, 0.0])  # the base stays on the ground
     assert np.all(grid.upper >= upper + 0.05 - 1e-9) and max(grid.state.shape) == 32
     assert np.all(grid.state == UNKNOWN)
+
+
+def test_the_padding_outside_the_targets_bounds_starts_free_only_when_asked():
+    grid = OccupancyGrid(np.zeros(3), np.array([4.0, 4.0, 2.0]), resolution=4)  # 1 m voxels, 4 x 4 x 2
+    out = outside(grid, np.array([1.0, 1.0, 0.0]), np.array([3.0, 3.0, 1.0]))
+    assert out.shape == (4, 4, 2) and (~out).sum() == 4 and not out[1:3, 1:3, 0].any()
+    assert outside(grid, np.array([0.5, 0.5, 0.0]), np.array([3.0, 3.0, 1.0]))[0:3, 0:3, 0].sum() == 0
+    scene = load_scene("test_building")
+    plain = target_grid(scene, OccupancyConfig(grid_resolution=16))
+    padded = target_grid(scene, OccupancyConfig(grid_resolution=16), padding_free=True)
+    assert (plain.state == UNKNOWN).all()
+    lower, upper = scene.bounds()
+    assert (padded.state == FREE).sum() == outside(padded, lower, upper).sum() > 0
+    assert (padded.state[~outside(padded, lower, upper)] == UNKNOWN).all()

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from nbv.flight.path import azimuth_step, shell_path
+from nbv.planning import lookahead as lookahead_module
 from nbv.planning.config import PlanSettings
 from nbv.planning.infogain import target_grid
 from nbv.planning.lookahead import (
@@ -383,3 +384,12 @@ def test_a_ceiling_holds_every_step_at_or_under_it_and_changes_a_climbing_flight
     with pytest.raises(ValueError, match="at most 90 .0: none., its sectors 4 or 8, its bands 1 to 3, got "
                                          "0.0, 0.0, 91, 4, 3"):
         LookaheadOptions(ceiling_deg=91)
+
+
+def test_the_planner_builds_its_grid_with_the_padding_free_when_asked(monkeypatch):
+    asked, build = [], lookahead_module.target_grid
+    monkeypatch.setattr(lookahead_module, "target_grid", lambda *args: asked.append(args[-1]) or build(*args))
+    world = PlanningWorld(config(), seed=3)
+    tiny(0.0, forward=True).plan(world, 2)
+    tiny(0.0, forward=True, padding_free=True).plan(world, 2)
+    assert asked == [False, True]

@@ -164,6 +164,8 @@ INDEX = (
     Result("selection/round49/README.md", "selection/round49/bands1/results.json",
            "its forty-ninth round: sides told by the horizontal sector alone (flew round 48's flights, not "
            "adopted)", LOOKS_EVAL),
+    Result("selection/round50/README.md", "selection/round50/padding_free/results.json",
+           "its fiftieth round: the grid's padding starts free (missed its bar, not adopted)", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

@@ -28,6 +28,8 @@ route, re-planned at each view (_rt). Round 40: `--restarts N` also improves N r
 (_rsN). Round 45: `--sectors 8` measures sides from eight 45-degree horizontal sectors, not quadrants (_sc8).
 Round 48: `--bands 2` tells sides by two vertical bands, down and level one (_bd2); round 49: `--bands 1` by
 none (_bd1). Round 50: `--padding-free` starts the grid's padding, outside the target's bounds, free (_pf).
+Round 51 (a diagnostic): `--stereo-mask` also flies stereo's own flight on the depth camera's exact depth,
+kept only at the pixels where stereo measures one (_mask): what stereo's density costs, apart from its errors.
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -39,6 +41,8 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
+
 from nbv.planning.config import PlanSettings
 from nbv.planning.lookahead import (
     BANDS,
@@ -49,11 +53,24 @@ from nbv.planning.lookahead import (
     LookaheadPlanner,
 )
 from nbv.planning.registry import make_planner
-from nbv.recon.occupancy import SECTORS
+from nbv.planning.world import PlanningWorld
+from nbv.recon.occupancy import SECTORS, OccupancyGrid
 from nbv.rl.presets import default_preset
+from render.viewpoint import Viewpoint
 
 sys.path.insert(0, str(Path(__file__).parent))
 import looks_eval  # noqa: E402
+
+
+class StereoMaskedPlanner(LookaheadPlanner):
+    """A diagnostic (round 51): each frame stereo measures fused with the depth camera's exact depth, at the
+    pixels where stereo measures a depth alone: stereo's density with exact depth's accuracy."""
+
+    def measured(self, world: PlanningWorld, grid: OccupancyGrid,
+                 view: Viewpoint) -> list[tuple[np.ndarray, Viewpoint]]:
+        """`LookaheadPlanner.measured`'s stereo depths, each replaced by the exact depth where finite."""
+        return [(np.where(np.isfinite(depth), world.source.render_depth(at), np.nan).astype(np.float32), at)
+                for depth, at in super().measured(world, grid, view)]
 
 
 def arguments() -> argparse.Namespace:
@@ -65,16 +82,7 @@ def arguments() -> argparse.Namespace:
     parser.add_argument("--distinct", action="store_true",
                         help="also fly each weight (camera, stereo) never stepping onto a view already "
                              "flown (name ending _d)")
-    parser.add_argument("--stereo", action="store_true",
-                        help="also fly each weight on stereo depth from the images (name ending _stereo)")
-    parser.add_argument("--no-camera", action="store_true",
-                        help="with --stereo, fly only the stereo look-ahead (not the depth camera's)")
-    parser.add_argument("--partners", nargs="+", choices=PARTNER_SIDES, default=list(STEREO_PARTNERS),
-                        help="with --stereo, the sides of each view's second frames")
-    parser.add_argument("--agree", type=int, default=0,
-                        help="with --stereo, fuse only the depths this many pairs agree on (0: every pair's)")
-    parser.add_argument("--votes", action="store_true",
-                        help="with --stereo, the grid weighs hits against passes, one vote an image")
+    stereo_arguments(parser)
     parser.add_argument("--frontier", type=int, default=0,
                         help="a view sees only each ray's first this many unknown voxels (0: all of them)")
     parser.add_argument("--allowance", type=float, default=0.0,
@@ -116,6 +124,23 @@ def arguments() -> argparse.Namespace:
                         help="with --route, also improve this many routes of random steps (round 40)")
     looks_eval.study_arguments(parser)
     return parser.parse_args()
+
+
+def stereo_arguments(parser: argparse.ArgumentParser) -> None:
+    """The stereo options: whether to fly it, its second frames, agreement, votes, the masked diagnostic."""
+    parser.add_argument("--stereo", action="store_true",
+                        help="also fly each weight on stereo depth from the images (name ending _stereo)")
+    parser.add_argument("--no-camera", action="store_true",
+                        help="with --stereo, fly only the stereo look-ahead (not the depth camera's)")
+    parser.add_argument("--partners", nargs="+", choices=PARTNER_SIDES, default=list(STEREO_PARTNERS),
+                        help="with --stereo, the sides of each view's second frames")
+    parser.add_argument("--agree", type=int, default=0,
+                        help="with --stereo, fuse only the depths this many pairs agree on (0: every pair's)")
+    parser.add_argument("--votes", action="store_true",
+                        help="with --stereo, the grid weighs hits against passes, one vote an image")
+    parser.add_argument("--stereo-mask", action="store_true",
+                        help="with --stereo, also fly the depth camera's exact depth kept only where stereo "
+                             "measures (name ending _mask; stereo's density, exact depth's accuracy)")
 
 
 def named(options: LookaheadOptions) -> str:
@@ -173,6 +198,11 @@ def main() -> None:
                 flown = name + stereo_suffix(paired) + "_d" * distinct
                 planners[flown], blanks[flown] = (stereo[False], False), stereo[True]
                 names.append(flown)
+                if args.stereo_mask:
+                    planners[flown + "_mask"] = (StereoMaskedPlanner(
+                        flight=w, grid=args.grid_resolution, rays=rays, depth="stereo",
+                        options=replace(paired, distinct=distinct)), False)
+                    names.append(flown + "_mask")
     results = looks_eval.evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work,
                                   blanks=blanks)
     looks_eval.conclude(args, results, names,

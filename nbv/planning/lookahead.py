@@ -42,17 +42,14 @@ the worst building 0.4 under the ring (round 28's 0.6) in 1.44x its metres, so i
 setting (`STEREO_SIDES`, `STEREO_HINGE`). The hinge's 13 m stopped it at 13 m at any view budget (`make
 tables`' budget part); round 33 let the battery follow the budget, one metre a view past 13 views
 (`battery_per_view_m`, `STEREO_PER_VIEW`): more coverage at 16 views, so it is the default. Round 35 gave rays
-looking down more steeply than 60 degrees sight bins of their own (`steep_deg`): that drew views to nearly
-overhead, so not the default. Round 36 made that band measure no side (`steep_measures` off: a wall seen only
-from overhead, at a grazing angle, stays unmeasured, and a view gains nothing for the sides it meets steeply)
-or held every step under 45 degrees (`ceiling_deg`): more coverage but not the courtyard gain its rule asked;
-round 37 confirmed the blind band from start views never flown (paper_results/selection/round37), so it is
-`lookahead-stereo`'s (`STEREO_STEEP`). Held out, scored once (paper_results/online/stereo, at 05e7f11): 4.4
-points above the ring in 1.46x its metres, 3.9 above random views on the courtyard (the bar is 5), five of six
-checks as round 31's setting. Round 39 (paper_results/selection/round39) chose every view still to take
-together, as one route re-planned at each view (`route`, `nbv.planning.route`): 0.9 points more coverage over
-nine start views, the worst building 1.0 above the ring, both courtyards up, five of six checks on both start
-sets, so it is `lookahead-stereo`'s (`STEREO_ROUTE`).
+looking down more steeply than 60 degrees sight bins of their own (`steep_deg`), which drew views overhead;
+round 36 made that band measure no side (`steep_measures` off: a wall seen only from overhead, at a grazing
+angle, stays unmeasured), confirmed from start views never flown in round 37, so it is `lookahead-stereo`'s
+(`STEREO_STEEP`); `ceiling_deg` (every step under 45 degrees) missed its rule. Held out, scored once
+(paper_results/online/stereo, at 05e7f11): 4.4 points above the ring in 1.46x its metres, 3.9 above random
+views on the courtyard (the bar is 5), five of six checks as round 31's setting. Round 39 chose every view
+still to take together, one route re-planned at each view (`route`, `nbv.planning.route`): 0.9 points more
+coverage over nine start views, the worst building 1.0 above the ring, both courtyards up (`STEREO_ROUTE`).
 """
 
 from __future__ import annotations
@@ -340,13 +337,19 @@ class LookaheadPlanner(Planner):
         return chosen
 
     def measure(self, world: PlanningWorld, grid: OccupancyGrid, view: Viewpoint) -> None:
-        """Fuse what the UAV measures at `view` into the grid: the depth camera's image, or stereo depth of
-        the view and each of its second frames (every pair swept apart; both frames' depth fused, or with
-        `agree` only the view's depth that many pairs agree on)."""
-        camera, center, stride = world.camera, world.target.center(), OccupancyConfig().integrate_ray_stride
+        """Fuse what the UAV measures at `view` into the grid (`measured`)."""
+        center, stride = world.target.center(), OccupancyConfig().integrate_ray_stride
+        for depth, at in self.measured(world, grid, view):
+            grid.integrate(depth, world.camera.K, viewpoint_to_c2w(at, center), stride)
+
+    def measured(self, world: PlanningWorld, grid: OccupancyGrid,
+                 view: Viewpoint) -> list[tuple[np.ndarray, Viewpoint]]:
+        """The depth images the UAV measures at `view`, each with the view it is from: the depth camera's
+        image, or stereo depth of the view and each of its second frames (every pair swept apart; both
+        frames' depth, or with `agree` only the view's depth that many pairs agree on)."""
+        camera, center = world.camera, world.target.center()
         if self.depth == "camera":
-            grid.integrate(world.source.render_depth(view), camera.K, viewpoint_to_c2w(view, center), stride)
-            return
+            return [(world.source.render_depth(view), view)]
 
         def frame(v: Viewpoint) -> np.ndarray:
             return np.zeros((camera.height, camera.width)) if self.blank_images \
@@ -356,15 +359,12 @@ class LookaheadPlanner(Planner):
         fused, views = [], []
         for side in self.options.partners:
             partner = stereo_partner(view, side=side)
-            other = viewpoint_to_c2w(partner, center)
-            fused.extend(box_stereo_depth(image, frame(partner), camera.K, pose, other, grid.lower,
-                                          grid.upper))
-            views.extend((pose, other))
+            fused.extend(box_stereo_depth(image, frame(partner), camera.K, pose,
+                                          viewpoint_to_c2w(partner, center), grid.lower, grid.upper))
+            views.extend((view, partner))
         if self.options.agree:
-            fused, views = [agreed_depth(fused[::2], StereoConfig().consistency,
-                                          self.options.agree)], [pose]
-        for depth, at in zip(fused, views, strict=True):
-            grid.integrate(depth, camera.K, at, stride)
+            return [(agreed_depth(fused[::2], StereoConfig().consistency, self.options.agree), view)]
+        return list(zip(fused, views, strict=True))
 
 
 def side_items(grid: OccupancyGrid, occupied: np.ndarray, known: np.ndarray, sides: float,

@@ -29,7 +29,8 @@ route, re-planned at each view (_rt). Round 40: `--restarts N` also improves N r
 Round 48: `--bands 2` tells sides by two vertical bands, down and level one (_bd2); round 49: `--bands 1` by
 none (_bd1). Round 50: `--padding-free` starts the grid's padding, outside the target's bounds, free (_pf).
 Round 51 (a diagnostic): `--stereo-mask` also flies stereo's own flight on the depth camera's exact depth,
-kept only at the pixels where stereo measures one (_mask): what stereo's density costs, apart from its errors.
+kept only at the pixels where stereo measures one (_mask): what stereo's density costs, apart from its errors;
+`--in-box` fuses no stereo depth whose point lies outside the target's bounds, grown by a voxel (_ib).
 
     python scripts/depth_teacher_eval.py --flight-reward 0.05 0.2 --out OUT --work WORK
 """
@@ -138,6 +139,8 @@ def stereo_arguments(parser: argparse.ArgumentParser) -> None:
                         help="with --stereo, fuse only the depths this many pairs agree on (0: every pair's)")
     parser.add_argument("--votes", action="store_true",
                         help="with --stereo, the grid weighs hits against passes, one vote an image")
+    parser.add_argument("--in-box", action="store_true",
+                        help="with --stereo, fuse no depth whose point lies outside the target's bounds")
     parser.add_argument("--stereo-mask", action="store_true",
                         help="with --stereo, also fly the depth camera's exact depth kept only where stereo "
                              "measures (name ending _mask; stereo's density, exact depth's accuracy)")
@@ -162,9 +165,10 @@ def named(options: LookaheadOptions) -> str:
 
 def stereo_suffix(paired: LookaheadOptions) -> str:
     """A stereo run's name ending: its second frames' sides where not `lookahead-stereo`'s, agreement,
-    votes (round 26), then `named`'s."""
+    votes (round 26), depths within the box (round 51), then `named`'s."""
     return "_stereo" + ("" if paired.partners == STEREO_PARTNERS else "_" + "-".join(paired.partners)) \
-        + (f"_a{paired.agree}" if paired.agree else "") + ("_v" if paired.votes else "") + named(paired)
+        + (f"_a{paired.agree}" if paired.agree else "") + ("_v" if paired.votes else "") \
+        + ("_ib" if paired.in_box else "") + named(paired)
 
 
 def main() -> None:
@@ -181,7 +185,8 @@ def main() -> None:
                                sectors=args.sectors, bands=args.bands, padding_free=args.padding_free,
                                steep_measures=not args.steep_blind, ceiling_deg=args.ceiling, pace=args.pace,
                                route=args.route, restarts=args.restarts)
-    paired = replace(options, partners=tuple(args.partners), agree=args.agree, votes=args.votes)
+    paired = replace(options, partners=tuple(args.partners), agree=args.agree, votes=args.votes,
+                     in_box=args.in_box)
     for w in args.flight_reward:
         name = f"depth-teacher_r{args.grid_resolution}_s{args.gain_ray_stride}_w{w:g}"
         for distinct in (False, True) if args.distinct else (False,):

@@ -166,6 +166,9 @@ INDEX = (
            "adopted)", LOOKS_EVAL),
     Result("selection/round50/README.md", "selection/round50/padding_free/results.json",
            "its fiftieth round: the grid's padding starts free (missed its bar, not adopted)", LOOKS_EVAL),
+    Result("selection/round51/README.md", "selection/round51/stereo_mask/results.json",
+           "its fifty-first round: stereo's pixels on exact depth (a diagnostic: its wrong depths cost 1.0 "
+           "of its 1.2 points, its density 0.2)", LOOKS_EVAL),
     Result("sfm/presets.md", "sfm/presets.json", "`nbv sfm` on each preset's full 288-view scan: registered "
            "share, models, centre and rotation errors",
            "python scripts/sfm_presets.py (commands in the file)"),

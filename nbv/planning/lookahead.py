@@ -34,22 +34,13 @@ the forward steps of a pilot's orbit (`forward`): five of six checks on the vali
 `lookahead-stereo`'s steps (`STEREO_FORWARD`). Held out, scored once (paper_results/online/stereo): 3.9 points
 above the ring in 1.29x its metres, 4.3 lost with blank frames, 1.7 under the ring on the walled compound,
 where it ends its flights near-hovering at 80 degrees (a forward step there is an arc of 0.13 m). Round 31
-(paper_results/selection/round31) found what the grid cannot see: an occupied voxel holds every face of the
-surface in it, so the underside of a tower's top, seen only from the low ring, counts as known once seen from
-above. With `sides` a view also gains for each occupied voxel it would meet from a direction never measured
-(`OccupancyGrid.sighted`); under a battery's hinge (2 a metre past 13 m) that passed five of six checks with
-the worst building 0.4 under the ring (round 28's 0.6) in 1.44x its metres, so it is `lookahead-stereo`'s
-setting (`STEREO_SIDES`, `STEREO_HINGE`). The hinge's 13 m stopped it at 13 m at any view budget (`make
-tables`' budget part); round 33 let the battery follow the budget, one metre a view past 13 views
-(`battery_per_view_m`, `STEREO_PER_VIEW`): more coverage at 16 views, so it is the default. Round 35 gave rays
-looking down more steeply than 60 degrees sight bins of their own (`steep_deg`), which drew views overhead;
-round 36 made that band measure no side (`steep_measures` off: a wall seen only from overhead, at a grazing
-angle, stays unmeasured), confirmed from start views never flown in round 37, so it is `lookahead-stereo`'s
-(`STEREO_STEEP`); `ceiling_deg` (every step under 45 degrees) missed its rule. Held out, scored once
-(paper_results/online/stereo, at 05e7f11): 4.4 points above the ring in 1.46x its metres, 3.9 above random
-views on the courtyard (the bar is 5), five of six checks as round 31's setting. Round 39 chose every view
-still to take together, one route re-planned at each view (`route`, `nbv.planning.route`): 0.9 points more
-coverage over nine start views, the worst building 1.0 above the ring, both courtyards up (`STEREO_ROUTE`).
+found what the grid cannot see: an occupied voxel holds every face of the surface in it, so with `sides` a
+view also gains for each occupied voxel it would meet from a side never measured (`OccupancyGrid.sighted`).
+The constants below record each setting chosen since, with its round: the sides' worth and a battery's hinge
+(`STEREO_SIDES`, `STEREO_HINGE`, `STEREO_PER_VIEW`), a steep band that measures no side (`STEREO_STEEP`), the
+route (`STEREO_ROUTE`). Held out, scored once (paper_results/online/stereo, at 781c773): 5.2 points above the
+ring in 1.42x its metres, 4.5 above random views on the courtyard `family:15` (the bar is 5), five of six
+checks. The options measured and not adopted stay one argument away (`LookaheadOptions`, docs/rl.md).
 """
 
 from __future__ import annotations
@@ -66,7 +57,7 @@ from nbv.planning.route import RouteSearch, view_key
 from nbv.planning.step_rules import ruled_out
 from nbv.recon.config import OccupancyConfig
 from nbv.recon.occupancy import OCCUPIED, SECTORS, UNKNOWN, OccupancyGrid
-from nbv.recon.stereo import StereoConfig, agreed_depth, box_stereo_depth, grayscale
+from nbv.recon.stereo import StereoConfig, agreed_depth, box_stereo_depth, grayscale, within_box
 from nbv.rl.env import action_to_viewpoint
 from nbv.rl.expert import CANDIDATES, best_action, expert_scores
 from nbv.rl.presets import ORBIT_STEP
@@ -188,6 +179,9 @@ class LookaheadOptions:
     (`OccupancyGrid`'s `sectors`; round 45)."""
     padding_free: bool = False
     """The grid's padding (voxels wholly outside the target's bounds) is free at first (round 50)."""
+    in_box: bool = False
+    """With stereo, a depth whose point lies outside the target's bounds (grown by a voxel) is not fused
+    (`within_box`; round 51)."""
     bands: int = 3
     """With `sides`, the vertical bands a side is told by: 3 (`sight_bin`'s down, level, up), 2 (down and
     level one: a wall seen from above is seen; round 48) or 1 (a sector's side, from any height; round 49)."""
@@ -363,7 +357,11 @@ class LookaheadPlanner(Planner):
                                           viewpoint_to_c2w(partner, center), grid.lower, grid.upper))
             views.extend((view, partner))
         if self.options.agree:
-            return [(agreed_depth(fused[::2], StereoConfig().consistency, self.options.agree), view)]
+            fused, views = [agreed_depth(fused[::2], StereoConfig().consistency, self.options.agree)], [view]
+        if self.options.in_box:
+            lower, upper = world.target.bounds()
+            fused = [within_box(d, camera.K, viewpoint_to_c2w(v, center), lower, upper, grid.voxel_size)
+                     for d, v in zip(fused, views, strict=True)]
         return list(zip(fused, views, strict=True))
 
 

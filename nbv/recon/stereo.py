@@ -178,6 +178,19 @@ def box_stereo_depth(ref: np.ndarray, src: np.ndarray, K: np.ndarray, ref_c2w: n
     return two_view_depth(ref, src, K, ref_c2w, src_c2w, near, far, config)
 
 
+def within_box(depth: np.ndarray, K: np.ndarray, c2w: np.ndarray, lower: np.ndarray,  # noqa: N803
+               upper: np.ndarray, tolerance: float = 0.0) -> np.ndarray:
+    """`depth` (H, W) NaN where its point lies outside the box `lower`-`upper` grown by `tolerance` metres on
+    every side: a target's surface cannot be there, and stereo's false matches beside a silhouette, the
+    background taking the building's depth, mostly land there (round 51)."""
+    pose = validate_pose(c2w)
+    height, width = depth.shape
+    points = (pixel_rays(np.asarray(K, np.float64), width, height) * np.nan_to_num(depth)[..., None]) \
+        @ pose[:3, :3].T + pose[:3, 3]
+    inside = np.all((points >= np.asarray(lower) - tolerance) & (points <= np.asarray(upper) + tolerance), -1)
+    return np.where(inside, depth, np.nan).astype(np.float32)
+
+
 def agreed_depth(depths: list[np.ndarray], tolerance: float, least: int = 2) -> np.ndarray:
     """One view's depth from several pairs' (each (H, W), NaN where that pair measured nothing): per pixel,
     the mean of the largest group of pairs within a relative `tolerance` of one of them, kept where that

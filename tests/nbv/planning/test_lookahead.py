@@ -39,7 +39,7 @@ from nbv.recon.occupancy import UNKNOWN, OccupancyGrid
 from nbv.rl.env import action_to_viewpoint
 from nbv.rl.expert import CANDIDATES
 from nbv.rl.presets import ORBIT_STEP
-from render.camera import UAVCamera
+from render.camera import UAVCamera, pixel_rays
 from render.settings import RenderSettings
 from render.viewpoint import Viewpoint, viewpoint_to_c2w
 from tests.nbv.rl.test_bov_observation import config
@@ -393,3 +393,19 @@ def test_the_planner_builds_its_grid_with_the_padding_free_when_asked(monkeypatc
     tiny(0.0, forward=True).plan(world, 2)
     tiny(0.0, forward=True, padding_free=True).plan(world, 2)
     assert asked == [False, True]
+
+
+def test_in_box_fuses_only_the_stereo_depths_inside_the_targets_bounds_grown_by_a_voxel():
+    world = PlanningWorld(config(camera=UAVCamera(160, 120), render=RenderSettings(spp=4)), seed=3)
+    grid = target_grid(world.target, OccupancyConfig(grid_resolution=16))
+    lower, upper = world.target.bounds()
+    for in_box in (False, True):
+        points = []
+        for depth, at in tiny(depth="stereo", in_box=in_box).measured(world, grid, world.start):
+            c2w, kept = viewpoint_to_c2w(at, world.target.center()), np.isfinite(depth)
+            rays = pixel_rays(world.camera.K, world.camera.width, world.camera.height)[kept]
+            points.append((rays * depth[kept][:, None]) @ c2w[:3, :3].T + c2w[:3, 3])
+        points = np.concatenate(points)
+        margin = grid.voxel_size + 1e-5
+        outside = np.any((points < lower - margin) | (points > upper + margin), axis=-1)
+        assert len(points) > 1000 and outside.any() != in_box  # stereo alone lands some outside; in_box none

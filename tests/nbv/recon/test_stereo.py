@@ -15,6 +15,7 @@ from nbv.recon.stereo import (
     grayscale,
     sweep,
     two_view_depth,
+    within_box,
 )
 from render.camera import UAVCamera, pixel_rays
 
@@ -120,3 +121,16 @@ def test_the_box_sweep_is_the_sweep_between_the_box_depths_from_either_view():
     swept = two_view_depth(left, right, CAMERA.K, pose(0.0), pose(BASELINE), near, far)
     for a, b in zip(boxed, swept, strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+def test_depths_outside_the_box_grown_by_the_tolerance_are_dropped():
+    depth = np.full((CAMERA.height, CAMERA.width), 2.0, np.float32)
+    depth[:, 80:], depth[:10] = 4.0, np.nan  # right half behind the box; top rows not measured
+    lower, upper = np.array([-10.0, -10.0, 1.0]), np.array([10.0, 10.0, 3.0])  # z-depths 1 to 3 m
+    kept = within_box(depth, CAMERA.K, pose(0.0), lower, upper)
+    assert np.all(kept[10:, :80] == 2.0) and np.isnan(kept[:, 80:]).all() and np.isnan(kept[:10]).all()
+    grown = within_box(depth, CAMERA.K, pose(0.0), lower, upper, tolerance=1.0)  # 4 m is on the grown box
+    np.testing.assert_array_equal(grown[10:], depth[10:])
+    moved = within_box(depth, CAMERA.K, pose(7.0), lower, upper)  # 7 m to the side: x from about 6 to 8
+    assert np.all(moved[10:, :80] == 2.0)
+    assert np.isnan(within_box(depth, CAMERA.K, pose(12.0), lower, upper)).all()  # x past 10: all outside

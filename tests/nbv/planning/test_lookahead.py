@@ -23,6 +23,7 @@ from nbv.planning.lookahead import (
     STEREO_ROUTE,
     STEREO_SIDES,
     STEREO_STEEP,
+    STEREO_VOTES,
     LookaheadOptions,
     LookaheadPlanner,
     lookahead_planner,
@@ -365,11 +366,13 @@ def test_stereo_measures_the_building_and_blank_frames_measure_nothing():
     assert (stereo.name, stereo.flight, stereo.depth) == ("lookahead-stereo", STEREO_FLIGHT, "stereo")
     assert stereo.options == LookaheadOptions(forward=True, sides=STEREO_SIDES, allowance_m=STEREO_HINGE[0],
                                               excess=STEREO_HINGE[1], battery_per_view_m=STEREO_PER_VIEW,
-                                              steep_deg=STEREO_STEEP, steep_measures=False, route=True)
+                                              steep_deg=STEREO_STEEP, steep_measures=False, route=True,
+                                              votes=True)
     assert STEREO_HINGE == (13.0, 2.0) and STEREO_SIDES == 1.0  # round 31's setting
     assert STEREO_PER_VIEW == 1.0  # round 33's: 13 m up to 13 views, one a view past them
     assert STEREO_STEEP == 60.0  # round 36's blind band, confirmed in round 37
     assert STEREO_ROUTE  # round 39: the rest of the flight planned as a whole
+    assert STEREO_VOTES  # round 51: one vote an image clears stereo's floaters
     assert make_planner("lookahead-stereo:0.2", PlanSettings(blank_images=True)).blank_images
     with pytest.raises(ValueError, match="depth from"):
         LookaheadPlanner(depth="lidar")

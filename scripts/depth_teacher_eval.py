@@ -196,17 +196,14 @@ def main() -> None:
                                                      options=replace(options, distinct=distinct)), False)
                 names.append(camera)
             if args.stereo:
-                stereo = {blank: LookaheadPlanner(flight=w, grid=args.grid_resolution, rays=rays,
-                                                  depth="stereo", blank_images=blank,
-                                                  options=replace(paired, distinct=distinct))
-                          for blank in (False, True)}
+                setting = dict(flight=w, grid=args.grid_resolution, rays=rays, depth="stereo",
+                               options=replace(paired, distinct=distinct))
                 flown = name + stereo_suffix(paired) + "_d" * distinct
-                planners[flown], blanks[flown] = (stereo[False], False), stereo[True]
+                planners[flown] = (LookaheadPlanner(**setting), False)
+                blanks[flown] = LookaheadPlanner(blank_images=True, **setting)
                 names.append(flown)
                 if args.stereo_mask:
-                    planners[flown + "_mask"] = (StereoMaskedPlanner(
-                        flight=w, grid=args.grid_resolution, rays=rays, depth="stereo",
-                        options=replace(paired, distinct=distinct)), False)
+                    planners[flown + "_mask"] = (StereoMaskedPlanner(**setting), False)
                     names.append(flown + "_mask")
     results = looks_eval.evaluate(planners, trained, args.scenes, args.seeds, args.views, args.work,
                                   blanks=blanks)
